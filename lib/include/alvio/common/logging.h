@@ -1,0 +1,50 @@
+#pragma once
+// A tiny levelled logger for the ROS-free core. The default sink writes to
+// stderr; nodelets redirect it to rosconsole and the MRPT logger to its file,
+// so the core never needs to know who is listening.
+
+#include <functional>
+#include <sstream>
+#include <string>
+
+namespace alvio {
+
+enum class LogLevel { kDebug = 0, kInfo = 1, kWarn = 2, kError = 3 };
+
+using LogSink = std::function<void(LogLevel, const std::string&)>;
+
+/// Replace the sink (thread-safe). Pass nullptr to restore the stderr sink.
+void setLogSink(LogSink sink);
+/// Messages below this level are dropped before formatting reaches the sink.
+void setLogLevel(LogLevel level);
+LogLevel logLevel();
+void logMessage(LogLevel level, const std::string& message);
+const char* logLevelName(LogLevel level);
+
+namespace detail {
+template <typename... Args>
+std::string concat(const Args&... args) {
+  std::ostringstream os;
+  (os << ... << args);
+  return os.str();
+}
+}  // namespace detail
+
+template <typename... Args>
+void logDebug(const Args&... args) {
+  if (logLevel() <= LogLevel::kDebug) logMessage(LogLevel::kDebug, detail::concat(args...));
+}
+template <typename... Args>
+void logInfo(const Args&... args) {
+  if (logLevel() <= LogLevel::kInfo) logMessage(LogLevel::kInfo, detail::concat(args...));
+}
+template <typename... Args>
+void logWarn(const Args&... args) {
+  if (logLevel() <= LogLevel::kWarn) logMessage(LogLevel::kWarn, detail::concat(args...));
+}
+template <typename... Args>
+void logError(const Args&... args) {
+  logMessage(LogLevel::kError, detail::concat(args...));
+}
+
+}  // namespace alvio

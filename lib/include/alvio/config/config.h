@@ -1,0 +1,24 @@
+#pragma once
+// The whole configuration of a run: one YAML file, one struct per component.
+// Every program (offline runner, simulator, nodelets) loads it the same way.
+
+#include <string>
+
+#include "alvio/config/sensor_options.h"
+
+namespace alvio {
+
+struct Config {
+  std::string source;  ///< the file it was loaded from ("" for defaults)
+  CameraOptions camera;
+  ImuOptions imu;
+  TopicOptions topics;
+
+  /// Load and validate `path`. Missing/malformed keys throw alvio::Error naming
+  /// file and key; unknown keys are logged as warnings.
+  static Config load(const std::string& path);
+  /// The configuration shipped as config/euroc.yaml, found next to the sources or installed.
+  static std::string defaultPath();
+};
+
+}  // namespace alvio

@@ -1,0 +1,26 @@
+#include "alvio/config/config.h"
+
+#include <cstdlib>
+
+#include "alvio/common/resource_path.h"
+#include "alvio/config/yaml_reader.h"
+
+namespace alvio {
+
+Config Config::load(const std::string& path) {
+  YamlReader yaml(path);
+  Config c;
+  c.source = path;
+  c.camera = CameraOptions::load(yaml, "camera");
+  c.imu = ImuOptions::load(yaml, "imu");
+  c.topics = TopicOptions::load(yaml, "topics");
+  yaml.warnUnknownKeys();
+  return c;
+}
+
+std::string Config::defaultPath() {
+  if (const char* env = std::getenv("ALVIO_CONFIG")) return env;
+  return findPackageFile("config/euroc.yaml");
+}
+
+}  // namespace alvio

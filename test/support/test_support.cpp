@@ -1,0 +1,35 @@
+#include "test_support.h"
+
+#include <cstdlib>
+#include <unistd.h>
+
+#include <filesystem>
+#include <set>
+
+namespace fs = std::filesystem;
+
+namespace alvio::test {
+
+std::string sharedDataDir() {
+  if (const char* env = std::getenv("ALVIO_SHARED_DATA")) return fs::is_directory(env) ? env : "";
+  const fs::path p = fs::path(ALVIO_SOURCE_DIR) / ".." / "shared" / "data";
+  return fs::is_directory(p) ? fs::canonical(p).string() : "";
+}
+
+std::string scratchDir() {
+  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  const fs::path dir = fs::temp_directory_path() /
+                       ("alvio_test_" + std::to_string(::getpid())) /
+                       (std::string(info->test_suite_name()) + "." + info->name());
+  // Emptied on the first call of each test only, so helpers can share it.
+  static std::set<std::string> prepared;
+  if (prepared.insert(dir.string()).second) fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir.string();
+}
+
+std::string sourcePath(const std::string& relative) {
+  return (fs::path(ALVIO_SOURCE_DIR) / relative).string();
+}
+
+}  // namespace alvio::test

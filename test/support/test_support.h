@@ -1,0 +1,25 @@
+#pragma once
+// Where tests find the project's shared EuRoC data (../shared/data next to the
+// repository, or $ALVIO_SHARED_DATA). Tests that need it skip with a message
+// when it is absent.
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+namespace alvio::test {
+
+/// The shared data folder, or "" when it does not exist.
+std::string sharedDataDir();
+/// A scratch folder unique to the running test, emptied on its first use in the test.
+std::string scratchDir();
+/// Path of a file inside the source tree.
+std::string sourcePath(const std::string& relative);
+
+}  // namespace alvio::test
+
+/// Skip the current test when the shared data is missing; sets `var` to its path.
+#define ALVIO_REQUIRE_SHARED_DATA(var)                                                  \
+  const std::string var = ::alvio::test::sharedDataDir();                               \
+  if (var.empty()) GTEST_SKIP() << "shared EuRoC data not found (../shared/data or "     \
+                                   "$ALVIO_SHARED_DATA): skipping";

@@ -1,0 +1,137 @@
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+
+#include "alvio/common/error.h"
+#include "alvio/common/logging.h"
+#include "alvio/config/config.h"
+#include "alvio/config/yaml_reader.h"
+#include "alvio/io/euroc_dataset.h"
+#include "test_support.h"
+
+using namespace alvio;
+
+namespace {
+std::string writeFile(const std::string& dir, const std::string& name, const std::string& text) {
+  const std::string path = dir + "/" + name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+// Expect an alvio::Error whose message contains every fragment.
+template <typename F>
+void expectErrorMentioning(F&& f, std::initializer_list<std::string> fragments) {
+  try {
+    f();
+    FAIL() << "expected alvio::Error";
+  } catch (const Error& e) {
+    for (const auto& frag : fragments)
+      EXPECT_NE(std::string(e.what()).find(frag), std::string::npos)
+          << "message '" << e.what() << "' lacks '" << frag << "'";
+  }
+}
+
+std::string eurocYaml() {
+  std::ifstream in(test::sourcePath("config/euroc.yaml"));
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+std::string eurocYamlWithout(const std::string& key) {
+  std::istringstream in(eurocYaml());
+  std::string out, line;
+  while (std::getline(in, line))
+    if (line.find(key + ":") == std::string::npos) out += line + "\n";
+  return out;
+}
+
+// The default config with the first occurrence of `from` replaced by `to`.
+std::string eurocYamlReplacing(const std::string& from, const std::string& to) {
+  std::string text = eurocYaml();
+  const auto pos = text.find(from);
+  EXPECT_NE(pos, std::string::npos) << from;
+  return text.replace(pos, from.size(), to);
+}
+}  // namespace
+
+TEST(Config, DefaultEurocConfigLoadsWithEurocValues) {
+  const Config c = Config::load(test::sourcePath("config/euroc.yaml"));
+  EXPECT_EQ(c.camera.width, 752);
+  EXPECT_EQ(c.camera.height, 480);
+  EXPECT_DOUBLE_EQ(c.camera.intrinsics[0], 458.654);
+  EXPECT_EQ(c.camera.distortion_model, "radial-tangential");
+  EXPECT_NEAR(c.camera.T_b_c.translation().x(), -0.0216401454975, 1e-12);
+  EXPECT_NEAR(c.camera.T_b_c.linear()(0, 1), -0.999880929698, 1e-6);
+  EXPECT_DOUBLE_EQ(c.imu.accelerometer_noise_density, 2.0e-3);
+  EXPECT_EQ(c.topics.image, "/cam0/image_raw");
+}
+
+TEST(Config, MissingKeyNamesFileAndKey) {
+  const std::string dir = test::scratchDir();
+  const std::string path = writeFile(dir, "bad.yaml", eurocYamlWithout("gyroscope_random_walk"));
+  expectErrorMentioning([&] { Config::load(path); }, {path, "imu.gyroscope_random_walk", "missing"});
+}
+
+TEST(Config, MalformedValueNamesKeyAndValue) {
+  const std::string dir = test::scratchDir();
+  const std::string path = writeFile(
+      dir, "bad.yaml",
+      eurocYamlReplacing("gyroscope_noise_density: 1.6968e-04", "gyroscope_noise_density: fast"));
+  expectErrorMentioning([&] { Config::load(path); }, {"imu.gyroscope_noise_density", "fast"});
+}
+
+TEST(Config, NegativeNoiseIsRejected) {
+  const std::string dir = test::scratchDir();
+  const std::string path = writeFile(
+      dir, "neg.yaml",
+      eurocYamlReplacing("accelerometer_random_walk: 3.0000e-3", "accelerometer_random_walk: -3e-3"));
+  expectErrorMentioning([&] { Config::load(path); }, {"accelerometer_random_walk", "positive"});
+}
+
+TEST(Config, NonRotationExtrinsicIsRejected) {
+  const std::string dir = test::scratchDir();
+  const std::string path = writeFile(dir, "rot.yaml", eurocYamlReplacing("0.0148655429818", "2.0"));
+  expectErrorMentioning([&] { Config::load(path); }, {"camera.T_BS", "not a rotation"});
+}
+
+TEST(Config, WrongListSizeIsRejected) {
+  const auto yaml = YamlReader::fromString("a: [1, 2, 3]\n", "mem.yaml");
+  expectErrorMentioning([&] { yaml.getDoubles("a", 4); }, {"mem.yaml", "'a'", "4 values"});
+}
+
+TEST(Config, UnknownKeysAreReported) {
+  const std::string dir = test::scratchDir();
+  const std::string path =
+      writeFile(dir, "unknown.yaml",
+                eurocYamlReplacing("rate_hz: 200", "rate_hz: 200\n  gravty: 9.8") +
+                    "imu_typo:\n  rate: 3\n");
+  std::vector<std::string> warnings;
+  setLogSink([&](LogLevel level, const std::string& msg) {
+    if (level == LogLevel::kWarn) warnings.push_back(msg);
+  });
+  Config::load(path);
+  setLogSink(nullptr);
+  ASSERT_EQ(warnings.size(), 2u);
+  EXPECT_NE(warnings[0].find("imu.gravty"), std::string::npos);
+  EXPECT_NE(warnings[1].find("imu_typo.rate"), std::string::npos);
+}
+
+TEST(Config, YamlSyntaxErrorGivesLine) {
+  const std::string dir = test::scratchDir();
+  const std::string path = writeFile(dir, "syntax.yaml", "a: 1\nb: [1, 2\nc: 3\n");
+  expectErrorMentioning([&] { YamlReader r(path); }, {path, "line"});
+}
+
+TEST(Config, EurocSensorYamlIsReadable) {
+  ALVIO_REQUIRE_SHARED_DATA(shared);
+  EurocDataset ds(shared + "/euroc_V1_01_easy_micro_kimera");
+  const auto cam = ds.cameraCalibration();
+  const auto imu = ds.imuCalibration();
+  ASSERT_TRUE(cam && imu);
+  const Config c = Config::load(test::sourcePath("config/euroc.yaml"));
+  EXPECT_TRUE(cam->T_b_c.isApprox(c.camera.T_b_c, 1e-12));
+  EXPECT_EQ(cam->intrinsics, c.camera.intrinsics);
+  EXPECT_EQ(cam->distortion_coefficients, c.camera.distortion_coefficients);
+  EXPECT_DOUBLE_EQ(imu->gyroscope_noise_density, c.imu.gyroscope_noise_density);
+  EXPECT_DOUBLE_EQ(imu->accelerometer_random_walk, c.imu.accelerometer_random_walk);
+}
