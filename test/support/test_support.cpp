@@ -1,7 +1,7 @@
 #include "test_support.h"
 
-#include <cstdlib>
 #include <unistd.h>
+#include <cstdlib>
 
 #include <filesystem>
 #include <set>
@@ -18,8 +18,7 @@ std::string sharedDataDir() {
 
 std::string scratchDir() {
   const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  const fs::path dir = fs::temp_directory_path() /
-                       ("alvio_test_" + std::to_string(::getpid())) /
+  const fs::path dir = fs::temp_directory_path() / ("alvio_test_" + std::to_string(::getpid())) /
                        (std::string(info->test_suite_name()) + "." + info->name());
   // Emptied on the first call of each test only, so helpers can share it.
   static std::set<std::string> prepared;

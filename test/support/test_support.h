@@ -19,7 +19,8 @@ std::string sourcePath(const std::string& relative);
 }  // namespace alvio::test
 
 /// Skip the current test when the shared data is missing; sets `var` to its path.
-#define ALVIO_REQUIRE_SHARED_DATA(var)                                                  \
-  const std::string var = ::alvio::test::sharedDataDir();                               \
-  if (var.empty()) GTEST_SKIP() << "shared EuRoC data not found (../shared/data or "     \
-                                   "$ALVIO_SHARED_DATA): skipping";
+#define ALVIO_REQUIRE_SHARED_DATA(var)                                \
+  const std::string var = ::alvio::test::sharedDataDir();             \
+  if (var.empty())                                                    \
+    GTEST_SKIP() << "shared EuRoC data not found (../shared/data or " \
+                    "$ALVIO_SHARED_DATA): skipping";

@@ -9,7 +9,9 @@
 using namespace alvio;
 
 namespace {
-CameraOptions eurocCamera() { return Config::load(test::sourcePath("config/euroc.yaml")).camera; }
+CameraOptions eurocCamera() {
+  return Config::load(test::sourcePath("config/euroc.yaml")).camera;
+}
 
 CameraOptions fisheyeCamera() {
   CameraOptions o;
@@ -17,8 +19,8 @@ CameraOptions fisheyeCamera() {
   o.width = 640;
   o.height = 480;
   o.intrinsics = {190.97, 190.97, 254.93, 256.89};  // a TUM-VI-like fisheye
-  o.distortion_coefficients = {0.0034823894022493434, 0.0007150348452162257,
-                               -0.0020532361418706202, 0.00020293673591811182};
+  o.distortion_coefficients = {0.0034823894022493434, 0.0007150348452162257, -0.0020532361418706202,
+                               0.00020293673591811182};
   return o;
 }
 
@@ -100,8 +102,9 @@ TEST(CameraModel, UndistortAgreesWithOpenCv) {
   const cv::Matx33d K(o.intrinsics[0], 0, o.intrinsics[2], 0, o.intrinsics[1], o.intrinsics[3], 0,
                       0, 1);
   std::vector<cv::Point2d> px = {{10, 10}, {367, 248}, {700, 450}, {100, 400}}, xy;
-  cv::undistortPoints(px, xy, K, o.distortion_coefficients, cv::noArray(), cv::noArray(),
-                      cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 100, 1e-14));
+  cv::undistortPoints(
+      px, xy, K, o.distortion_coefficients, cv::noArray(), cv::noArray(),
+      cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 100, 1e-14));
   for (std::size_t i = 0; i < px.size(); ++i) {
     const Eigen::Vector2d u = cam->undistort({px[i].x, px[i].y});
     EXPECT_NEAR(u.x(), xy[i].x, 1e-6);

@@ -69,7 +69,8 @@ TEST(Config, DefaultEurocConfigLoadsWithEurocValues) {
 TEST(Config, MissingKeyNamesFileAndKey) {
   const std::string dir = test::scratchDir();
   const std::string path = writeFile(dir, "bad.yaml", eurocYamlWithout("gyroscope_random_walk"));
-  expectErrorMentioning([&] { Config::load(path); }, {path, "imu.gyroscope_random_walk", "missing"});
+  expectErrorMentioning([&] { Config::load(path); },
+                        {path, "imu.gyroscope_random_walk", "missing"});
 }
 
 TEST(Config, MalformedValueNamesKeyAndValue) {
@@ -82,9 +83,9 @@ TEST(Config, MalformedValueNamesKeyAndValue) {
 
 TEST(Config, NegativeNoiseIsRejected) {
   const std::string dir = test::scratchDir();
-  const std::string path = writeFile(
-      dir, "neg.yaml",
-      eurocYamlReplacing("accelerometer_random_walk: 3.0000e-3", "accelerometer_random_walk: -3e-3"));
+  const std::string path = writeFile(dir, "neg.yaml",
+                                     eurocYamlReplacing("accelerometer_random_walk: 3.0000e-3",
+                                                        "accelerometer_random_walk: -3e-3"));
   expectErrorMentioning([&] { Config::load(path); }, {"accelerometer_random_walk", "positive"});
 }
 
@@ -101,10 +102,9 @@ TEST(Config, WrongListSizeIsRejected) {
 
 TEST(Config, UnknownKeysAreReported) {
   const std::string dir = test::scratchDir();
-  const std::string path =
-      writeFile(dir, "unknown.yaml",
-                eurocYamlReplacing("rate_hz: 200", "rate_hz: 200\n  gravty: 9.8") +
-                    "imu_typo:\n  rate: 3\n");
+  const std::string path = writeFile(
+      dir, "unknown.yaml",
+      eurocYamlReplacing("rate_hz: 200", "rate_hz: 200\n  gravty: 9.8") + "imu_typo:\n  rate: 3\n");
   std::vector<std::string> warnings;
   setLogSink([&](LogLevel level, const std::string& msg) {
     if (level == LogLevel::kWarn) warnings.push_back(msg);

@@ -55,8 +55,8 @@ Eigen::Matrix3d hornRotation(const Points3& a, const Points3& b) {
                Syz = M(1, 2), Szx = M(2, 0), Szy = M(2, 1), Szz = M(2, 2);
   Eigen::Matrix4d N;
   N << Sxx + Syy + Szz, Syz - Szy, Szx - Sxz, Sxy - Syx,  //
-      Syz - Szy, Sxx - Syy - Szz, Sxy + Syx, Szx + Sxz,    //
-      Szx - Sxz, Sxy + Syx, -Sxx + Syy - Szz, Syz + Szy,   //
+      Syz - Szy, Sxx - Syy - Szz, Sxy + Syx, Szx + Sxz,   //
+      Szx - Sxz, Sxy + Syx, -Sxx + Syy - Szz, Syz + Szy,  //
       Sxy - Syx, Szx + Sxz, Syz + Szy, -Sxx - Syy + Szz;
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix4d> es(N);
   const Eigen::Vector4d q = es.eigenvectors().col(3);  // largest eigenvalue
@@ -74,7 +74,8 @@ double tumBenchmarkAte(const Trajectory& est, const Trajectory& gt, double max_d
   for (std::size_t e = 0; e < est.size(); ++e) {
     while (lo < gt.size() && gt[lo].t <= est[e].t - max_dt) ++lo;
     for (std::size_t g = lo; g < gt.size() && gt[g].t < est[e].t + max_dt; ++g)
-      if (std::abs(gt[g].t - est[e].t) < max_dt) cands.push_back({std::abs(gt[g].t - est[e].t), e, g});
+      if (std::abs(gt[g].t - est[e].t) < max_dt)
+        cands.push_back({std::abs(gt[g].t - est[e].t), e, g});
   }
   std::stable_sort(cands.begin(), cands.end(), [](const C& x, const C& y) { return x.d < y.d; });
   std::vector<char> ue(est.size()), ug(gt.size());
@@ -150,7 +151,8 @@ TEST(Alignment, PosYawRecoversYawOnlyAndRefusesRollPitch) {
 
 TEST(Alignment, NoneLeavesTheEstimateAlone) {
   const Trajectory gt = syntheticPath();
-  const Trajectory est = transformed(gt, 1.0, Eigen::Matrix3d::Identity(), Eigen::Vector3d(0, 0, 1));
+  const Trajectory est =
+      transformed(gt, 1.0, Eigen::Matrix3d::Identity(), Eigen::Vector3d(0, 0, 1));
   EvaluationOptions o;
   o.alignment = AlignmentMode::kNone;
   EXPECT_NEAR(evaluateTrajectory(est, gt, o).ate_translation_m.rmse, 1.0, 1e-12);
@@ -158,8 +160,9 @@ TEST(Alignment, NoneLeavesTheEstimateAlone) {
 
 TEST(Alignment, NoisyEstimateMatchesHorn) {
   const Trajectory gt = syntheticPath();
-  Trajectory est = transformed(gt, 1.0, Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitX()).toRotationMatrix(),
-                               Eigen::Vector3d(1, 2, 3));
+  Trajectory est =
+      transformed(gt, 1.0, Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitX()).toRotationMatrix(),
+                  Eigen::Vector3d(1, 2, 3));
   std::mt19937 rng(42);
   std::normal_distribution<double> n(0, 0.05);
   for (auto& p : est) p.p += Eigen::Vector3d(n(rng), n(rng), n(rng));
@@ -218,7 +221,8 @@ TEST(SharedTrajectories, Se3AteMatchesTumBenchmarkWithin1mm) {
     if (path.find("kavehsgh") != std::string::npos) seq = "MH_01_easy";
     std::string gt_path = gt_dir + seq + ".txt";
     if (path.find("V1_01") != std::string::npos)
-      gt_path = shared + "/euroc_groundtruth/plvio/benchmark_publisher/config/V1_01_easy/v101_gt_tum.txt";
+      gt_path =
+          shared + "/euroc_groundtruth/plvio/benchmark_publisher/config/V1_01_easy/v101_gt_tum.txt";
     else if (seq.empty())
       continue;
     SCOPED_TRACE(path);
@@ -244,7 +248,8 @@ TEST(SharedTrajectories, VinsMonoMh05NoLoopIsAbout30cm) {
        {shared + "/euroc_trajectories/vins_mono_noted_Yixin-F/output/vins_result_no_loop.csv",
         shared + "/euroc_trajectories/pl_vins_repo_vins_mono/Trajactory/TrajVINS/MH-05-difficult/"
                  "vins_result_no_loop.csv"}) {
-    const EvaluationResult r = evaluateTrajectory(readTrajectory(est_path), gt, EvaluationOptions());
+    const EvaluationResult r =
+        evaluateTrajectory(readTrajectory(est_path), gt, EvaluationOptions());
     // Published: 0.302 m; independent runs differ by several centimetres.
     EXPECT_NEAR(r.ate_translation_m.rmse, 0.30, 0.06) << est_path;
   }

@@ -49,9 +49,10 @@ TEST(TrajectoryIo, TumRoundTrip) {
 }
 
 TEST(TrajectoryIo, FormatsAreDetected) {
-  const auto euroc = writeFile("gt.csv",
-                               "#timestamp, p_x, p_y, p_z, q_w, q_x, q_y, q_z\n"
-                               "1403638519492829440,4.46,-1.68,0.58,0.238261,-0.757610,-0.348629,-0.497711\n");
+  const auto euroc =
+      writeFile("gt.csv",
+                "#timestamp, p_x, p_y, p_z, q_w, q_x, q_y, q_z\n"
+                "1403638519492829440,4.46,-1.68,0.58,0.238261,-0.757610,-0.348629,-0.497711\n");
   const auto vins = writeFile("vins.csv",
                               "1403638523377829632,-0.00978,-0.03525,0.09381,-0.05507,0.80043,"
                               "0.01311,0.59675,-0.07,-0.06,-0.61,\n");
@@ -98,7 +99,8 @@ TEST(TrajectoryIo, UnsortedAndDuplicateStampsAreReported) {
   EXPECT_NE(msg.find(path + ":3"), std::string::npos) << msg;
   EXPECT_NE(msg.find("earlier"), std::string::npos) << msg;
   // The lenient policy sorts and drops the duplicate, keeping the first.
-  const Trajectory t = readTrajectory(path, TrajectoryFormat::kAuto, TimeOrderPolicy::kSortAndDedup);
+  const Trajectory t =
+      readTrajectory(path, TrajectoryFormat::kAuto, TimeOrderPolicy::kSortAndDedup);
   ASSERT_EQ(t.size(), 3u);
   EXPECT_DOUBLE_EQ(t[1].t, 2.0);
   EXPECT_DOUBLE_EQ(t[2].p.x(), 0.0);

@@ -22,13 +22,13 @@ std::unique_ptr<CameraModel> CameraModel::create(const CameraOptions& o) {
   const auto& k = o.intrinsics;
   const auto& d = o.distortion_coefficients;
   if (o.distortion_model == "equidistant")
-    return std::make_unique<EquidistantCamera>(o.width, o.height, k[0], k[1], k[2], k[3], d[0], d[1],
-                                               d[2], d[3]);
+    return std::make_unique<EquidistantCamera>(o.width, o.height, k[0], k[1], k[2], k[3], d[0],
+                                               d[1], d[2], d[3]);
   if (o.distortion_model == "none")
     return std::make_unique<PinholeRadtanCamera>(o.width, o.height, k[0], k[1], k[2], k[3], 0, 0, 0,
                                                  0);
-  return std::make_unique<PinholeRadtanCamera>(o.width, o.height, k[0], k[1], k[2], k[3], d[0], d[1],
-                                               d[2], d[3], d.size() > 4 ? d[4] : 0.0);
+  return std::make_unique<PinholeRadtanCamera>(o.width, o.height, k[0], k[1], k[2], k[3], d[0],
+                                               d[1], d[2], d[3], d.size() > 4 ? d[4] : 0.0);
 }
 
 PinholeRadtanCamera::PinholeRadtanCamera(int width, int height, double fx, double fy, double cx,

@@ -30,8 +30,10 @@ std::string ArgParser::help() const {
     const Spec& s = specs_.at(name);
     std::string left = "  --" + name + (s.is_flag ? "" : " VALUE");
     os << left << std::string(left.size() < 26 ? 26 - left.size() : 1, ' ') << s.help;
-    if (s.required) os << " (required)";
-    else if (!s.is_flag && !s.fallback.empty()) os << " [default: " << s.fallback << "]";
+    if (s.required)
+      os << " (required)";
+    else if (!s.is_flag && !s.fallback.empty())
+      os << " [default: " << s.fallback << "]";
     os << "\n";
   }
   return os.str();
@@ -56,7 +58,8 @@ bool ArgParser::parse(int argc, char** argv) {
       name = name.substr(0, eq);
     }
     const auto it = specs_.find(name);
-    if (it == specs_.end()) throw Error(program_ + ": unknown option '--" + name + "' (see --help)");
+    if (it == specs_.end())
+      throw Error(program_ + ": unknown option '--" + name + "' (see --help)");
     if (it->second.is_flag) {
       if (has_inline) throw Error(program_ + ": flag '--" + name + "' takes no value");
       values_[name] = "1";
@@ -80,7 +83,9 @@ std::string ArgParser::get(const std::string& name) const {
   return specs_.at(name).fallback;
 }
 
-bool ArgParser::isSet(const std::string& name) const { return values_.count(name) > 0; }
+bool ArgParser::isSet(const std::string& name) const {
+  return values_.count(name) > 0;
+}
 
 double ArgParser::getDouble(const std::string& name) const {
   const std::string v = get(name);

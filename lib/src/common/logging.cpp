@@ -13,10 +13,14 @@ std::atomic<int> g_level{static_cast<int>(LogLevel::kInfo)};
 
 const char* logLevelName(LogLevel level) {
   switch (level) {
-    case LogLevel::kDebug: return "debug";
-    case LogLevel::kInfo: return "info";
-    case LogLevel::kWarn: return "warn";
-    case LogLevel::kError: return "error";
+    case LogLevel::kDebug:
+      return "debug";
+    case LogLevel::kInfo:
+      return "info";
+    case LogLevel::kWarn:
+      return "warn";
+    case LogLevel::kError:
+      return "error";
   }
   return "?";
 }
@@ -26,8 +30,12 @@ void setLogSink(LogSink sink) {
   g_sink = std::move(sink);
 }
 
-void setLogLevel(LogLevel level) { g_level = static_cast<int>(level); }
-LogLevel logLevel() { return static_cast<LogLevel>(g_level.load()); }
+void setLogLevel(LogLevel level) {
+  g_level = static_cast<int>(level);
+}
+LogLevel logLevel() {
+  return static_cast<LogLevel>(g_level.load());
+}
 
 void logMessage(LogLevel level, const std::string& message) {
   if (static_cast<int>(level) < g_level.load()) return;

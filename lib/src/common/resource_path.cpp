@@ -13,7 +13,8 @@ std::string findPackageFile(const std::string& relative) {
   std::vector<fs::path> candidates;
   if (const char* env = std::getenv("ALVIO_ROOT")) candidates.push_back(fs::path(env) / relative);
   candidates.push_back(fs::path(ALVIO_SOURCE_DIR) / relative);
-  // Installed catkin layout: tools and scripts in <prefix>/lib/alvio/, data in <prefix>/share/alvio/.
+  // Installed catkin layout: tools and scripts in <prefix>/lib/alvio/, data in
+  // <prefix>/share/alvio/.
   std::error_code ec;
   const fs::path exe_dir = fs::read_symlink("/proc/self/exe", ec).parent_path();
   if (!ec) {
@@ -22,7 +23,8 @@ std::string findPackageFile(const std::string& relative) {
   }
   for (const auto& p : candidates)
     if (fs::exists(p)) return p.string();
-  throw Error("cannot find package file '" + relative + "' (set ALVIO_ROOT to the alvio source folder)");
+  throw Error("cannot find package file '" + relative +
+              "' (set ALVIO_ROOT to the alvio source folder)");
 }
 
 }  // namespace alvio

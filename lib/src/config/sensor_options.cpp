@@ -17,7 +17,9 @@ void requirePositive(double value, const std::string& where) {
 }
 // "camera" + "rate_hz" -> "camera.rate_hz"; an empty prefix reads top-level keys
 // (as in EuRoC's own sensor.yaml).
-std::string keyPrefix(const std::string& prefix) { return prefix.empty() ? "" : prefix + "."; }
+std::string keyPrefix(const std::string& prefix) {
+  return prefix.empty() ? "" : prefix + ".";
+}
 std::string whereOf(const YamlReader& yaml, const std::string& prefix) {
   return prefix.empty() ? yaml.path() : yaml.path() + ": " + prefix;
 }
@@ -48,8 +50,10 @@ void CameraOptions::validate(const std::string& where) const {
   const std::size_t n = distortion_coefficients.size();
   if (distortion_model == "radial-tangential" || distortion_model == "radtan") {
     if (n != 4 && n != 5)
-      throw Error(where + ".distortion_coefficients: radial-tangential needs 4 values (k1 k2 p1 p2)"
-                  ", got " + std::to_string(n));
+      throw Error(where +
+                  ".distortion_coefficients: radial-tangential needs 4 values (k1 k2 p1 p2)"
+                  ", got " +
+                  std::to_string(n));
   } else if (distortion_model == "equidistant") {
     if (n != 4)
       throw Error(where + ".distortion_coefficients: equidistant needs 4 values (k1..k4), got " +

@@ -29,8 +29,7 @@ std::string stripOpenCvHeader(const std::string& text) {
   return text;
 }
 
-void collectKeys(const YAML::Node& node, const std::string& prefix,
-                 std::vector<std::string>* out) {
+void collectKeys(const YAML::Node& node, const std::string& prefix, std::vector<std::string>* out) {
   if (!node.IsMap()) {
     out->push_back(prefix);
     return;
@@ -98,7 +97,9 @@ YAML::Node YamlReader::require(const std::string& key) const {
   return *node;
 }
 
-bool YamlReader::has(const std::string& key) const { return find(key, false).has_value(); }
+bool YamlReader::has(const std::string& key) const {
+  return find(key, false).has_value();
+}
 
 namespace {
 template <typename T>
@@ -177,8 +178,7 @@ Eigen::Isometry3d YamlReader::getTransform(const std::string& key) const {
     for (std::size_t r = 0; r < 4; ++r) {
       if (!node[r].IsSequence() || node[r].size() != 4)
         throw Error(where(key) + " must be a 4x4 nested list");
-      for (std::size_t c = 0; c < 4; ++c)
-        data.push_back(convertDouble(node[r][c], where(key)));
+      for (std::size_t c = 0; c < 4; ++c) data.push_back(convertDouble(node[r][c], where(key)));
     }
   } else {
     data = getDoubles(key, 16);
@@ -203,7 +203,9 @@ Eigen::Isometry3d YamlReader::getTransform(const std::string& key) const {
   return T;
 }
 
-void YamlReader::markKnown(const std::string& key) const { used_.insert(key); }
+void YamlReader::markKnown(const std::string& key) const {
+  used_.insert(key);
+}
 
 std::vector<std::string> YamlReader::unknownKeys() const {
   std::vector<std::string> all;

@@ -17,10 +17,14 @@ AlignmentMode parseAlignmentMode(const std::string& name) {
 
 const char* alignmentModeName(AlignmentMode mode) {
   switch (mode) {
-    case AlignmentMode::kSE3: return "se3";
-    case AlignmentMode::kSim3: return "sim3";
-    case AlignmentMode::kPosYaw: return "posyaw";
-    case AlignmentMode::kNone: return "none";
+    case AlignmentMode::kSE3:
+      return "se3";
+    case AlignmentMode::kSim3:
+      return "sim3";
+    case AlignmentMode::kPosYaw:
+      return "posyaw";
+    case AlignmentMode::kNone:
+      return "none";
   }
   return "?";
 }

@@ -28,8 +28,9 @@ std::string formatEvaluationText(const EvaluationResult& r, const EvaluationOpti
                 a.rmse, a.mean, a.median, a.std, a.max);
   os << buf;
   const auto& b = r.ate_rotation_deg;
-  std::snprintf(buf, sizeof(buf), "ATE rotation [deg]:  rmse %.3f  mean %.3f  median %.3f  max %.3f\n",
-                b.rmse, b.mean, b.median, b.max);
+  std::snprintf(buf, sizeof(buf),
+                "ATE rotation [deg]:  rmse %.3f  mean %.3f  median %.3f  max %.3f\n", b.rmse,
+                b.mean, b.median, b.max);
   os << buf << "RPE over sub-trajectories:\n"
      << "  length [m] (fraction)  pairs  trans mean [%]  trans median [%]  rot mean [deg/m]\n";
   for (const auto& s : r.rpe) {
@@ -54,9 +55,10 @@ std::string evaluationToJson(const EvaluationResult& r, const EvaluationOptions&
   j["poses"] = {{"estimated", r.est_poses}, {"ground_truth", r.gt_poses}, {"matched", r.matched}};
   j["path_length_m"] = r.path_length_m;
   j["transform"] = {{"scale", r.alignment.s},
-                    {"rotation", {{r.alignment.R(0, 0), r.alignment.R(0, 1), r.alignment.R(0, 2)},
-                                  {r.alignment.R(1, 0), r.alignment.R(1, 1), r.alignment.R(1, 2)},
-                                  {r.alignment.R(2, 0), r.alignment.R(2, 1), r.alignment.R(2, 2)}}},
+                    {"rotation",
+                     {{r.alignment.R(0, 0), r.alignment.R(0, 1), r.alignment.R(0, 2)},
+                      {r.alignment.R(1, 0), r.alignment.R(1, 1), r.alignment.R(1, 2)},
+                      {r.alignment.R(2, 0), r.alignment.R(2, 1), r.alignment.R(2, 2)}}},
                     {"translation", {r.alignment.t.x(), r.alignment.t.y(), r.alignment.t.z()}}};
   j["ate_translation_m"] = statsJson(r.ate_translation_m);
   j["ate_rotation_deg"] = statsJson(r.ate_rotation_deg);

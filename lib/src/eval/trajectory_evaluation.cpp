@@ -105,8 +105,7 @@ EvaluationResult evaluateTrajectory(const Trajectory& est, const Trajectory& gt,
 
   // Relative errors over sub-trajectories of a fixed fraction of the path length.
   std::vector<double> dist(pairs.size(), 0.0);
-  for (std::size_t k = 1; k < pairs.size(); ++k)
-    dist[k] = dist[k - 1] + (pg[k] - pg[k - 1]).norm();
+  for (std::size_t k = 1; k < pairs.size(); ++k) dist[k] = dist[k - 1] + (pg[k] - pg[k - 1]).norm();
   r.path_length_m = dist.back();
   for (const double fraction : options.rpe_fractions) {
     RpeSegment seg;
@@ -122,8 +121,7 @@ EvaluationResult evaluateTrajectory(const Trajectory& est, const Trajectory& gt,
         const Eigen::Matrix3d dR_gt = R_gt[i].transpose() * R_gt[j];
         const Eigen::Vector3d dt_gt = R_gt[i].transpose() * (pg[j] - pg[i]);
         const Eigen::Matrix3d dR_est = R_est[i].transpose() * R_est[j];
-        const Eigen::Vector3d dt_est =
-            R_est[i].transpose() * (r.est_aligned[j] - r.est_aligned[i]);
+        const Eigen::Vector3d dt_est = R_est[i].transpose() * (r.est_aligned[j] - r.est_aligned[i]);
         const Eigen::Vector3d t_err = dR_gt.transpose() * (dt_est - dt_gt);
         trans.push_back(100.0 * t_err.norm() / seg.length_m);
         rot.push_back(rotationAngleDeg(dR_gt.transpose() * dR_est) / seg.length_m);

@@ -49,14 +49,16 @@ std::optional<ImuOptions> EurocDataset::imuCalibration() const {
   return ImuOptions::load(yaml, "");
 }
 
-std::vector<ImageRecord> readEurocImageCsv(const std::string& csv_path, const std::string& image_dir,
-                                           TimeOrderPolicy policy) {
+std::vector<ImageRecord> readEurocImageCsv(const std::string& csv_path,
+                                           const std::string& image_dir, TimeOrderPolicy policy) {
   TextTableReader reader(csv_path);
   std::vector<ImageRecord> out;
   std::vector<int> lines;
   std::vector<std::string> f;
   while (reader.next(&f)) {
-    if (f.size() < 2) reader.fail("expected 'timestamp_ns,filename', got " + std::to_string(f.size()) + " column(s)");
+    if (f.size() < 2)
+      reader.fail("expected 'timestamp_ns,filename', got " + std::to_string(f.size()) +
+                  " column(s)");
     ImageRecord r;
     r.t_ns = reader.toInt64(f[0], 0);
     r.path = (fs::path(image_dir) / f[1]).string();
@@ -92,7 +94,8 @@ GroundTruth readEurocGroundTruthCsv(const std::string& csv_path, TimeOrderPolicy
   std::vector<int> lines;
   std::vector<std::string> f;
   while (reader.next(&f)) {
-    if (f.size() < 8) reader.fail("expected at least 8 columns (t_ns, p, q_wxyz), got " + std::to_string(f.size()));
+    if (f.size() < 8)
+      reader.fail("expected at least 8 columns (t_ns, p, q_wxyz), got " + std::to_string(f.size()));
     GroundTruthState s;
     s.t_ns = reader.toInt64(f[0], 0);
     for (int i = 0; i < 3; ++i) s.p[i] = reader.toDouble(f[1 + i], 1 + i);
@@ -164,7 +167,8 @@ std::string matrixYaml(const Eigen::Matrix4d& m) {
   os.precision(15);
   os << "  cols: 4\n  rows: 4\n  data: [";
   for (int r = 0; r < 4; ++r)
-    for (int c = 0; c < 4; ++c) os << m(r, c) << (r == 3 && c == 3 ? "]\n" : (c == 3 ? ",\n         " : ", "));
+    for (int c = 0; c < 4; ++c)
+      os << m(r, c) << (r == 3 && c == 3 ? "]\n" : (c == 3 ? ",\n         " : ", "));
   return os.str();
 }
 }  // namespace
@@ -172,7 +176,8 @@ std::string matrixYaml(const Eigen::Matrix4d& m) {
 void writeEurocCameraYaml(const std::string& path, const CameraOptions& c) {
   std::ostringstream os;
   os << "%YAML:1.0\n# Written by alvio.\nsensor_type: camera\ncomment: alvio cam0\n\n"
-     << "T_BS:\n" << matrixYaml(c.T_b_c.matrix()) << "\nrate_hz: " << c.rate_hz << "\n"
+     << "T_BS:\n"
+     << matrixYaml(c.T_b_c.matrix()) << "\nrate_hz: " << c.rate_hz << "\n"
      << "resolution: [" << c.width << ", " << c.height << "]\n"
      << "camera_model: " << c.camera_model << "\n"
      << "intrinsics: [" << joinNumbers(c.intrinsics) << "] #fu, fv, cu, cv\n"
@@ -185,7 +190,8 @@ void writeEurocImuYaml(const std::string& path, const ImuOptions& imu) {
   std::ostringstream os;
   os.precision(10);
   os << "%YAML:1.0\n# Written by alvio.\nsensor_type: imu\ncomment: alvio imu0\n\n"
-     << "T_BS:\n" << matrixYaml(Eigen::Matrix4d::Identity()) << "rate_hz: " << imu.rate_hz << "\n\n"
+     << "T_BS:\n"
+     << matrixYaml(Eigen::Matrix4d::Identity()) << "rate_hz: " << imu.rate_hz << "\n\n"
      << "gyroscope_noise_density: " << imu.gyroscope_noise_density << "\n"
      << "gyroscope_random_walk: " << imu.gyroscope_random_walk << "\n"
      << "accelerometer_noise_density: " << imu.accelerometer_noise_density << "\n"

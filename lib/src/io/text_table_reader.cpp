@@ -13,9 +13,13 @@ TextTableReader::TextTableReader(const std::string& path) : path_(path), in_(pat
   if (!in_) throw Error("cannot open '" + path + "'");
 }
 
-std::string TextTableReader::where() const { return path_ + ":" + std::to_string(line_number_); }
+std::string TextTableReader::where() const {
+  return path_ + ":" + std::to_string(line_number_);
+}
 
-void TextTableReader::fail(const std::string& message) const { throw Error(where() + ": " + message); }
+void TextTableReader::fail(const std::string& message) const {
+  throw Error(where() + ": " + message);
+}
 
 bool TextTableReader::next(std::vector<std::string>* fields) {
   std::string line;

@@ -21,10 +21,14 @@ TrajectoryFormat parseTrajectoryFormat(const std::string& name) {
 
 const char* trajectoryFormatName(TrajectoryFormat format) {
   switch (format) {
-    case TrajectoryFormat::kAuto: return "auto";
-    case TrajectoryFormat::kTum: return "tum";
-    case TrajectoryFormat::kEuroc: return "euroc";
-    case TrajectoryFormat::kVinsMono: return "vins";
+    case TrajectoryFormat::kAuto:
+      return "auto";
+    case TrajectoryFormat::kTum:
+      return "tum";
+    case TrajectoryFormat::kEuroc:
+      return "euroc";
+    case TrajectoryFormat::kVinsMono:
+      return "vins";
   }
   return "?";
 }

@@ -11,8 +11,12 @@
 
 namespace alvio {
 
-inline double nsToSec(int64_t ns) { return static_cast<double>(ns) * 1e-9; }
-inline int64_t secToNs(double s) { return static_cast<int64_t>(std::llround(s * 1e9)); }
+inline double nsToSec(int64_t ns) {
+  return static_cast<double>(ns) * 1e-9;
+}
+inline int64_t secToNs(double s) {
+  return static_cast<int64_t>(std::llround(s * 1e9));
+}
 
 /// One IMU sample in the body frame: angular rate (rad/s) and specific force (m/s^2).
 struct ImuSample {

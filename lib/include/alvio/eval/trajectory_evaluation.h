@@ -26,8 +26,8 @@ struct ErrorStats {
 };
 
 struct RpeSegment {
-  double fraction = 0;   ///< of the ground-truth path length
-  double length_m = 0;   ///< sub-trajectory length
+  double fraction = 0;             ///< of the ground-truth path length
+  double length_m = 0;             ///< sub-trajectory length
   ErrorStats translation_percent;  ///< |t error| / length * 100
   ErrorStats rotation_deg_per_m;   ///< rotation error angle / length
 };

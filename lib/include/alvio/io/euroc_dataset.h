@@ -16,8 +16,7 @@ class EurocDataset {
  public:
   /// `root` may be the folder holding mav0/ or mav0/ itself. Throws alvio::Error
   /// naming the missing folder or file.
-  explicit EurocDataset(const std::string& root,
-                        TimeOrderPolicy policy = TimeOrderPolicy::kStrict);
+  explicit EurocDataset(const std::string& root, TimeOrderPolicy policy = TimeOrderPolicy::kStrict);
 
   const std::string& mav0() const { return mav0_; }
   /// cam0 frames in time order; image paths are absolute.
@@ -37,7 +36,8 @@ class EurocDataset {
 };
 
 // Readers of the single files, usable on their own.
-std::vector<ImageRecord> readEurocImageCsv(const std::string& csv_path, const std::string& image_dir,
+std::vector<ImageRecord> readEurocImageCsv(const std::string& csv_path,
+                                           const std::string& image_dir,
                                            TimeOrderPolicy policy = TimeOrderPolicy::kStrict);
 std::vector<ImuSample> readEurocImuCsv(const std::string& csv_path,
                                        TimeOrderPolicy policy = TimeOrderPolicy::kStrict);

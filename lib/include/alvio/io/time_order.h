@@ -14,7 +14,7 @@
 namespace alvio {
 
 enum class TimeOrderPolicy {
-  kStrict,     ///< throw alvio::Error at the first unsorted or duplicate stamp
+  kStrict,       ///< throw alvio::Error at the first unsorted or duplicate stamp
   kSortAndDedup  ///< sort, keep the first of duplicates, log a warning with counts
 };
 
@@ -43,9 +43,10 @@ TimeOrderReport enforceTimeOrder(std::vector<Record, Alloc>* records, const std:
   std::stable_sort(records->begin(), records->end(),
                    [&](const Record& a, const Record& b) { return stamp(a) < stamp(b); });
   const auto before = records->size();
-  records->erase(std::unique(records->begin(), records->end(),
-                             [&](const Record& a, const Record& b) { return stamp(a) == stamp(b); }),
-                 records->end());
+  records->erase(
+      std::unique(records->begin(), records->end(),
+                  [&](const Record& a, const Record& b) { return stamp(a) == stamp(b); }),
+      records->end());
   logWarn(path, ": ", report.unsorted, " out-of-order and ", report.duplicates,
           " duplicate timestamps; sorted and dropped ", before - records->size(), " duplicates");
   return report;

@@ -23,7 +23,8 @@ TrajectoryFormat detectTrajectoryFormat(const std::string& path);
 
 /// Read a trajectory; malformed rows throw alvio::Error with file and line.
 /// Quaternions are normalised; a quaternion far from unit length is an error.
-Trajectory readTrajectory(const std::string& path, TrajectoryFormat format = TrajectoryFormat::kAuto,
+Trajectory readTrajectory(const std::string& path,
+                          TrajectoryFormat format = TrajectoryFormat::kAuto,
                           TimeOrderPolicy policy = TimeOrderPolicy::kStrict);
 
 /// Write TUM with 9 decimals on time (ns resolution) and 9 on values. Atomic.

@@ -1,0 +1,75 @@
+#pragma once
+// Marginalisation of old states into a Gaussian prior (Schur complement), and
+// the factor that applies that prior in later windows.
+//
+// Blocks of ambient size 7 are poses (PoseManifold, tangent size 6); all other
+// blocks are Euclidean. Jacobians are taken in the tangent space.
+
+#include <ceres/cost_function.h>
+#include <ceres/loss_function.h>
+
+#include <Eigen/Core>
+#include <map>
+#include <memory>
+#include <vector>
+
+namespace alvio {
+
+class MarginalizationInfo {
+ public:
+  /// A factor that touches the states being removed. Takes ownership of `cost` and `loss`.
+  /// `drop` lists the indices (into `blocks`) of the parameter blocks to marginalise.
+  void addResidualBlock(ceres::CostFunction* cost, ceres::LossFunction* loss,
+                        std::vector<double*> blocks, std::vector<int> drop);
+
+  /// Evaluate all factors at the current parameter values and form the prior.
+  /// Returns false when nothing is kept (no prior).
+  bool marginalize();
+
+  /// After the window shifted: the kept blocks' new addresses (old address -> new).
+  /// Blocks absent from `shift` are dropped from the prior's parameter list (error).
+  std::vector<double*> keptBlocks(const std::map<double*, double*>& shift) const;
+
+  // The prior, for MarginalizationFactor.
+  int keptTangentSize() const { return kept_tangent_size_; }
+  const std::vector<int>& keptSizes() const { return kept_sizes_; }
+  const std::vector<int>& keptTangentSizes() const { return kept_tangent_sizes_; }
+  const std::vector<std::vector<double>>& keptLinearizationPoints() const { return kept_values_; }
+  const Eigen::MatrixXd& linearizedJacobian() const { return linearized_jacobian_; }
+  const Eigen::VectorXd& linearizedResidual() const { return linearized_residual_; }
+  /// The kept blocks' addresses before the shift.
+  const std::vector<double*>& keptAddresses() const { return kept_addresses_; }
+
+ private:
+  struct Block {
+    std::unique_ptr<ceres::CostFunction> cost;
+    std::unique_ptr<ceres::LossFunction> loss;
+    std::vector<double*> blocks;
+    std::vector<int> drop;
+  };
+  std::vector<Block> factors_;
+  std::vector<double*> kept_addresses_;
+  std::vector<int> kept_sizes_, kept_tangent_sizes_;
+  std::vector<std::vector<double>> kept_values_;
+  int kept_tangent_size_ = 0;
+  Eigen::MatrixXd linearized_jacobian_;
+  Eigen::VectorXd linearized_residual_;
+};
+
+/// r = r0 + J * Minus(x, x0) over the kept blocks.
+class MarginalizationFactor : public ceres::CostFunction {
+ public:
+  explicit MarginalizationFactor(std::shared_ptr<const MarginalizationInfo> info);
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override;
+
+ private:
+  std::shared_ptr<const MarginalizationInfo> info_;
+};
+
+/// Tangent size of a block of ambient size `size` (7 -> 6, else unchanged).
+inline int tangentSizeOf(int size) {
+  return size == 7 ? 6 : size;
+}
+
+}  // namespace alvio
