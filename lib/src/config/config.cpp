@@ -14,6 +14,8 @@ Config Config::load(const std::string& path) {
   c.camera = CameraOptions::load(yaml, "camera");
   c.imu = ImuOptions::load(yaml, "imu");
   c.topics = TopicOptions::load(yaml, "topics");
+  c.points = PointTrackerOptions::load(yaml, "points");
+  c.estimator = EstimatorOptions::load(yaml, "estimator");
   yaml.warnUnknownKeys();
   return c;
 }

@@ -5,6 +5,8 @@
 #include <string>
 
 #include "alvio/config/sensor_options.h"
+#include "alvio/estimator/estimator_options.h"
+#include "alvio/frontend/point_tracker.h"
 
 namespace alvio {
 
@@ -13,6 +15,8 @@ struct Config {
   CameraOptions camera;
   ImuOptions imu;
   TopicOptions topics;
+  PointTrackerOptions points;
+  EstimatorOptions estimator;
 
   /// Load and validate `path`. Missing/malformed keys throw alvio::Error naming
   /// file and key; unknown keys are logged as warnings.

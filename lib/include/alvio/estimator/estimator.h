@@ -1,0 +1,172 @@
+#pragma once
+// The tightly coupled sliding-window visual-inertial estimator (VINS-Mono
+// style): IMU preintegration between keyframes, inverse-depth point landmarks,
+// a Ceres optimisation per frame, marginalisation of the oldest keyframe (or
+// dropping of the second-newest frame), initialisation by visual SfM plus
+// visual-inertial alignment, failure detection and reset.
+//
+// Implementation is split by responsibility: estimator.cpp (frame flow, IMU,
+// sliding, failure handling), estimator_optimization.cpp (the Ceres problem
+// and marginalisation), estimator_initialization.cpp (SfM + alignment).
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <array>
+#include <deque>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "alvio/common/timing.h"
+#include "alvio/common/types.h"
+#include "alvio/config/sensor_options.h"
+#include "alvio/estimator/estimator_options.h"
+#include "alvio/estimator/point_landmarks.h"
+#include "alvio/frontend/feature_frame.h"
+#include "alvio/imu/imu_preintegration.h"
+
+namespace alvio {
+
+class MarginalizationInfo;
+
+enum class EstimatorStatus { kInitializing, kTracking };
+
+/// The body state of one frame, in the output world frame (see Estimator).
+struct BodyState {
+  double t = 0;
+  Eigen::Vector3d p = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond q = Eigen::Quaterniond::Identity();
+  Eigen::Vector3d v = Eigen::Vector3d::Zero();
+  Eigen::Vector3d ba = Eigen::Vector3d::Zero();
+  Eigen::Vector3d bg = Eigen::Vector3d::Zero();
+  EIGEN_MAKE_ALIGNED_OPERATOR_NEW
+};
+
+/// Something a user should know about: initialisation, a reset, why it waits.
+struct EstimatorEvent {
+  enum class Kind { kWaiting, kInitialized, kFailure, kReset };
+  double t = 0;
+  Kind kind = Kind::kWaiting;
+  std::string message;
+  /// For kInitialized: the window's body states right after initialisation.
+  std::vector<BodyState, Eigen::aligned_allocator<BodyState>> window;
+  double scale = 0;  ///< visual-inertial alignment scale (kInitialized)
+};
+
+class Estimator {
+ public:
+  Estimator(const EstimatorOptions& options, const CameraOptions& camera, const ImuOptions& imu);
+  ~Estimator();
+
+  /// Queue an IMU sample (time-ordered; older or duplicate stamps are dropped with a warning).
+  void addImu(const ImuSample& sample);
+  /// Process a frame. IMU up to its time (and one sample after, for interpolation) should be
+  /// queued. Returns true when the frame has a pose estimate (after initialisation).
+  bool addFrame(const FeatureFrame& frame, FrameTiming* timing = nullptr);
+
+  EstimatorStatus status() const { return status_; }
+  /// State of the newest frame, in the output world frame.
+  BodyState latestState() const;
+  /// Keyframe states of the window, oldest first, in the output world frame.
+  std::vector<BodyState, Eigen::aligned_allocator<BodyState>> windowStates() const;
+  /// Triangulated landmarks in the output world frame, by id.
+  std::map<int, Eigen::Vector3d> landmarkPositions() const;
+  int resetCount() const { return reset_count_; }
+  /// Events since the last call (moved out).
+  std::vector<EstimatorEvent> takeEvents();
+  /// Residual blocks and iterations of the last optimisation (diagnostics).
+  int lastIterations() const { return last_iterations_; }
+  int lastPointResiduals() const { return last_point_residuals_; }
+  const PointLandmarks& points() const { return points_; }
+
+ private:
+  struct ImageFrame {
+    std::map<int, Eigen::Vector3d> xy1;               // observations by landmark id
+    Eigen::Matrix3d R = Eigen::Matrix3d::Identity();  // body rotation (SfM frame)
+    Eigen::Vector3d T = Eigen::Vector3d::Zero();      // camera position (SfM frame)
+    std::unique_ptr<ImuPreintegration> imu;           // from the previous frame
+    bool is_keyframe = false;
+  };
+  enum class Marginalization { kOld, kSecondNew };
+
+  // estimator.cpp
+  void clearState();
+  void feedImu(double t, const Eigen::Vector3d& acc, const Eigen::Vector3d& gyr);
+  void processImu(double dt, const Eigen::Vector3d& acc, const Eigen::Vector3d& gyr);
+  void consumeImuUpTo(double t);
+  void slideWindow();
+  bool detectFailure(std::string* why) const;
+  void reset(double t, const std::string& why);
+  BodyState toOutput(const BodyState& s) const;
+  void event(EstimatorEvent::Kind kind, double t, const std::string& message);
+  ImuNoise imuNoise() const;
+
+  // estimator_optimization.cpp
+  void optimize(FrameTiming* timing);
+  void statesToParameters();
+  void parametersToStates();
+  void marginalize();
+  void removeReprojectionOutliers();
+
+  // estimator_initialization.cpp
+  bool initialize(double t);
+  bool initialStructure(double t);
+  bool alignWithImu(double t);
+
+  EstimatorOptions options_;
+  CameraOptions camera_;
+  ImuOptions imu_options_;
+  Eigen::Isometry3d T_b_c_;
+  Eigen::Vector3d gravity_;  // (0, 0, -g)
+  int W_;                    // window size
+
+  EstimatorStatus status_ = EstimatorStatus::kInitializing;
+  Marginalization marginalization_ = Marginalization::kOld;
+  int frame_count_ = 0;
+
+  // Window states, W_ + 1 slots.
+  std::vector<double> headers_;
+  std::vector<Eigen::Vector3d> Ps_, Vs_, Bas_, Bgs_;
+  std::vector<Eigen::Matrix3d> Rs_;
+  std::vector<std::unique_ptr<ImuPreintegration>> preintegrations_;
+  std::vector<std::vector<double>> dt_buf_;
+  std::vector<std::vector<Eigen::Vector3d>> acc_buf_, gyr_buf_;
+  PointLandmarks points_;
+
+  // Ceres parameter blocks; addresses are stable for the estimator's lifetime.
+  std::vector<std::array<double, 7>> para_pose_;
+  std::vector<std::array<double, 9>> para_speed_bias_;
+  std::vector<double> para_inv_depth_;
+
+  std::shared_ptr<MarginalizationInfo> last_marginalization_;
+  std::vector<double*> last_marginalization_blocks_;
+
+  // Frames since the oldest keyframe, for initialisation (by time in ns).
+  std::map<int64_t, ImageFrame> all_frames_;
+  std::unique_ptr<ImuPreintegration> tmp_preintegration_;
+
+  // IMU stream.
+  std::deque<ImuSample> imu_queue_;
+  bool has_imu_ = false;
+  double imu_time_ = 0;  // time of the last sample fed to processImu
+  Eigen::Vector3d acc_0_ = Eigen::Vector3d::Zero(), gyr_0_ = Eigen::Vector3d::Zero();
+  int64_t last_queued_imu_ns_ = 0;
+
+  double last_init_attempt_ = -1e9;
+  std::string last_wait_reason_;
+  Eigen::Matrix3d last_R_ = Eigen::Matrix3d::Identity(), back_R0_ = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d last_P_ = Eigen::Vector3d::Zero(), back_P0_ = Eigen::Vector3d::Zero();
+
+  // Output continuity across resets: output = yaw(out_yaw_) * (p - out_from_) + out_to_.
+  double out_yaw_ = 0;
+  Eigen::Vector3d out_from_ = Eigen::Vector3d::Zero(), out_to_ = Eigen::Vector3d::Zero();
+  bool have_output_ = false, align_output_after_reset_ = false;
+  BodyState last_output_;
+  int reset_count_ = 0;
+  double init_scale_ = 0;
+  int last_iterations_ = 0, last_point_residuals_ = 0;
+  std::vector<EstimatorEvent> events_;
+};
+
+}  // namespace alvio

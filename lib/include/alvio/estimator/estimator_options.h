@@ -1,0 +1,37 @@
+#pragma once
+// Options of the sliding-window estimator (config section "estimator").
+
+#include <string>
+
+namespace alvio {
+
+class YamlReader;
+
+struct EstimatorOptions {
+  int window_size = 10;                ///< keyframes in the window (plus the newest frame)
+  double keyframe_parallax_px = 10;    ///< mean parallax that makes a frame a keyframe
+  int max_iterations = 8;              ///< Ceres iterations per frame (no time limit: determinism)
+  int num_threads = 1;                 ///< Ceres threads
+  double point_sigma_px = 1.5;         ///< reprojection noise of points
+  std::string robust_loss = "cauchy";  ///< cauchy | huber | none
+  double robust_loss_scale = 1.0;      ///< in units of sigma
+  double outlier_reprojection_px = 3.0;  ///< landmarks with a larger mean error are removed
+  double imu_noise_scale = 1.0;          ///< multiplies every IMU noise density and random walk
+
+  // Initialisation.
+  double init_min_parallax_px = 30;  ///< between the reference frame and the newest
+  int init_min_correspondences = 20;
+  double init_retry_interval_s = 0.1;
+
+  // Failure detection (reset and re-initialise).
+  int min_tracked_points = 10;  ///< fewer points tracked into a new frame (after init)
+  double max_accel_bias = 2.5;  ///< m/s^2
+  double max_gyro_bias = 1.0;   ///< rad/s
+  double max_translation_jump_m = 5.0;
+  double max_z_jump_m = 1.0;
+  double max_rotation_jump_deg = 50.0;
+
+  static EstimatorOptions load(const YamlReader& yaml, const std::string& prefix);
+};
+
+}  // namespace alvio

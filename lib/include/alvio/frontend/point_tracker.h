@@ -1,0 +1,62 @@
+#pragma once
+// KLT point front end (as in VINS-Mono): Shi-Tomasi corners tracked by
+// pyramidal Lucas-Kanade, forward-backward checked, outliers removed by RANSAC
+// on the fundamental matrix, new corners detected away from existing ones.
+
+#include <memory>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+#include <string>
+#include <vector>
+
+#include "alvio/camera/camera_model.h"
+#include "alvio/common/timing.h"
+#include "alvio/frontend/feature_frame.h"
+
+namespace alvio {
+
+class YamlReader;
+
+struct PointTrackerOptions {
+  int max_features = 150;            ///< target number of tracked corners
+  int min_distance_px = 30;          ///< minimum distance between corners
+  double quality_level = 0.01;       ///< Shi-Tomasi quality relative to the best corner
+  double ransac_threshold_px = 1.0;  ///< fundamental-matrix RANSAC threshold
+  bool equalize = true;              ///< CLAHE before tracking (robust to exposure changes)
+  int klt_window = 21;
+  int klt_levels = 3;
+  bool forward_backward_check = true;  ///< track back and reject points that do not return
+  double forward_backward_max_px = 0.5;
+
+  static PointTrackerOptions load(const YamlReader& yaml, const std::string& prefix);
+};
+
+class PointTracker {
+ public:
+  PointTracker(const PointTrackerOptions& options, std::shared_ptr<const CameraModel> camera);
+
+  /// Track into the next 8-bit grey image. Stage times go to `timing` when given.
+  FeatureFrame track(const cv::Mat& gray, int64_t t_ns, FrameTiming* timing = nullptr);
+  /// Forget all tracks (after a reset, or an image-size change).
+  void reset();
+  /// The preprocessed (equalised) image of the last frame, shared with the line front end.
+  const cv::Mat& lastImage() const { return prev_img_; }
+
+ private:
+  void rejectWithFundamental(std::vector<cv::Point2f>* prev, std::vector<cv::Point2f>* cur,
+                             std::vector<int>* ids, std::vector<int>* counts) const;
+  void detectNew(const cv::Mat& img);
+
+  PointTrackerOptions options_;
+  std::shared_ptr<const CameraModel> camera_;
+  cv::Ptr<cv::CLAHE> clahe_;
+  cv::Mat prev_img_;
+  int64_t prev_t_ns_ = 0;
+  std::vector<cv::Point2f> pts_;
+  std::vector<int> ids_, track_counts_;
+  std::vector<Eigen::Vector2d> prev_xy_;  // by index into pts_ of the previous frame
+  std::vector<int> prev_ids_;
+  int next_id_ = 0;
+};
+
+}  // namespace alvio

@@ -1,0 +1,50 @@
+#pragma once
+// Runs the pipeline over a recorded dataset as fast as it can, deterministically,
+// with a progress bar, and writes the run's files:
+//   trajectory.tum   body pose T_w_b at every frame after initialisation (TUM)
+//   timing.csv       per-frame stage times (ms)
+//   events.log       initialisation, waiting reasons, failures and resets
+//   summary.json     counts, timing summary, initialisation quality and ATE
+// and, when the dataset has ground truth, prints the ATE.
+
+#include <optional>
+#include <string>
+
+#include "alvio/common/timing.h"
+#include "alvio/config/config.h"
+#include "alvio/estimator/estimator.h"
+#include "alvio/eval/trajectory_evaluation.h"
+#include "alvio/pipeline/sensor_source.h"
+
+namespace alvio {
+
+struct RunOptions {
+  std::string out_dir;
+  bool progress = true;
+  int max_frames = -1;  ///< stop after this many images (-1: all)
+};
+
+struct InitializationQuality {
+  double time = 0;                ///< when it initialised (s, dataset time)
+  double since_motion_s = -1;     ///< after the first motion in the ground truth
+  double scale_error = -1;        ///< |s - 1| of the window positions vs ground truth
+  double gravity_error_deg = -1;  ///< mean roll/pitch error of the window
+};
+
+struct RunResult {
+  std::size_t frames = 0, poses = 0, skipped_images = 0;
+  int resets = 0;
+  Trajectory trajectory;
+  TimingLog timing;
+  std::optional<InitializationQuality> initialization;
+  std::optional<EvaluationResult> evaluation;  ///< SE(3) ATE, when ground truth exists
+};
+
+RunResult runOffline(SensorSource& source, const Config& config, const RunOptions& options);
+
+/// Initialisation quality of `window` against ground truth `gt` (positions, roll/pitch).
+InitializationQuality initializationQuality(
+    const std::vector<BodyState, Eigen::aligned_allocator<BodyState>>& window,
+    const Trajectory& gt);
+
+}  // namespace alvio

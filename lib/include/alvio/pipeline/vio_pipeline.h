@@ -1,0 +1,46 @@
+#pragma once
+// The whole offline/online pipeline in one object: images and IMU in, poses
+// out. Used by the offline runner; the nodelets split the same parts across
+// the tracker and estimator nodelets.
+
+#include <memory>
+#include <opencv2/core.hpp>
+#include <vector>
+
+#include "alvio/camera/camera_model.h"
+#include "alvio/common/timing.h"
+#include "alvio/config/config.h"
+#include "alvio/estimator/estimator.h"
+#include "alvio/frontend/point_tracker.h"
+
+namespace alvio {
+
+struct PipelineOutput {
+  bool has_pose = false;  ///< false until initialised, and on the frame of a reset
+  BodyState state;        ///< newest frame, output world frame
+  EstimatorStatus status = EstimatorStatus::kInitializing;
+  FeatureFrame features;
+  FrameTiming timing;
+  std::vector<EstimatorEvent> events;
+};
+
+class VioPipeline {
+ public:
+  explicit VioPipeline(const Config& config);
+
+  void addImu(const ImuSample& sample) { estimator_.addImu(sample); }
+  /// Track and estimate one 8-bit grey image. IMU up to (and one sample beyond) its time
+  /// should have been added.
+  PipelineOutput addImage(const cv::Mat& gray, int64_t t_ns);
+
+  const Estimator& estimator() const { return estimator_; }
+  const CameraModel& camera() const { return *camera_; }
+
+ private:
+  Config config_;
+  std::shared_ptr<const CameraModel> camera_;
+  PointTracker point_tracker_;
+  Estimator estimator_;
+};
+
+}  // namespace alvio

@@ -1,0 +1,380 @@
+#include "alvio/estimator/estimator.h"
+
+#include <cmath>
+
+#include "alvio/common/logging.h"
+#include "alvio/common/rotation.h"
+#include "alvio/estimator/factors/marginalization.h"
+
+namespace alvio {
+
+Estimator::Estimator(const EstimatorOptions& options, const CameraOptions& camera,
+                     const ImuOptions& imu)
+    : options_(options),
+      camera_(camera),
+      imu_options_(imu),
+      T_b_c_(camera.T_b_c),
+      gravity_(0, 0, -imu.gravity_magnitude),
+      W_(options.window_size),
+      points_(options.window_size, options.keyframe_parallax_px / camera.intrinsics[0]),
+      para_pose_(options.window_size + 1),
+      para_speed_bias_(options.window_size + 1) {
+  clearState();
+}
+
+Estimator::~Estimator() = default;
+
+ImuNoise Estimator::imuNoise() const {
+  const double s = options_.imu_noise_scale;
+  ImuNoise n;
+  n.acc_noise_density = s * imu_options_.accelerometer_noise_density;
+  n.gyr_noise_density = s * imu_options_.gyroscope_noise_density;
+  n.acc_random_walk = s * imu_options_.accelerometer_random_walk;
+  n.gyr_random_walk = s * imu_options_.gyroscope_random_walk;
+  return n;
+}
+
+void Estimator::clearState() {
+  const int n = W_ + 1;
+  headers_.assign(n, 0.0);
+  Ps_.assign(n, Eigen::Vector3d::Zero());
+  Vs_.assign(n, Eigen::Vector3d::Zero());
+  Bas_.assign(n, Eigen::Vector3d::Zero());
+  Bgs_.assign(n, Eigen::Vector3d::Zero());
+  Rs_.assign(n, Eigen::Matrix3d::Identity());
+  preintegrations_.clear();
+  preintegrations_.resize(n);
+  dt_buf_.assign(n, {});
+  acc_buf_.assign(n, {});
+  gyr_buf_.assign(n, {});
+  points_.clear();
+  last_marginalization_.reset();
+  last_marginalization_blocks_.clear();
+  all_frames_.clear();
+  tmp_preintegration_.reset();
+  status_ = EstimatorStatus::kInitializing;
+  marginalization_ = Marginalization::kOld;
+  frame_count_ = 0;
+  last_init_attempt_ = -1e9;
+  last_wait_reason_.clear();
+}
+
+void Estimator::event(EstimatorEvent::Kind kind, double t, const std::string& message) {
+  EstimatorEvent e;
+  e.kind = kind;
+  e.t = t;
+  e.message = message;
+  events_.push_back(std::move(e));
+}
+
+std::vector<EstimatorEvent> Estimator::takeEvents() {
+  std::vector<EstimatorEvent> out;
+  out.swap(events_);
+  return out;
+}
+
+void Estimator::addImu(const ImuSample& s) {
+  if (has_imu_ || !imu_queue_.empty()) {
+    if (s.t_ns <= last_queued_imu_ns_) {
+      logWarn("IMU sample at ", s.t_ns, " ns is not after the previous one (", last_queued_imu_ns_,
+              " ns): dropped");
+      return;
+    }
+  }
+  if (!s.acc.allFinite() || !s.gyr.allFinite()) {
+    logWarn("IMU sample at ", s.t_ns, " ns has a NaN or Inf value: dropped");
+    return;
+  }
+  last_queued_imu_ns_ = s.t_ns;
+  imu_queue_.push_back(s);
+}
+
+void Estimator::feedImu(double t, const Eigen::Vector3d& acc, const Eigen::Vector3d& gyr) {
+  if (!has_imu_) {
+    has_imu_ = true;
+    imu_time_ = t;
+    acc_0_ = acc;
+    gyr_0_ = gyr;
+    return;
+  }
+  const double dt = t - imu_time_;
+  if (dt <= 0) return;
+  processImu(dt, acc, gyr);
+  imu_time_ = t;
+}
+
+void Estimator::consumeImuUpTo(double t) {
+  while (!imu_queue_.empty() && imu_queue_.front().t() <= t) {
+    feedImu(imu_queue_.front().t(), imu_queue_.front().acc, imu_queue_.front().gyr);
+    imu_queue_.pop_front();
+  }
+  if (!has_imu_ || imu_time_ >= t) return;
+  // Close the interval exactly at the frame time: interpolate with the next sample, or hold
+  // the last one when the next has not arrived.
+  Eigen::Vector3d acc = acc_0_, gyr = gyr_0_;
+  if (!imu_queue_.empty()) {
+    const ImuSample& next = imu_queue_.front();
+    const double w = (t - imu_time_) / (next.t() - imu_time_);
+    acc = (1 - w) * acc_0_ + w * next.acc;
+    gyr = (1 - w) * gyr_0_ + w * next.gyr;
+  }
+  feedImu(t, acc, gyr);
+}
+
+void Estimator::processImu(double dt, const Eigen::Vector3d& acc, const Eigen::Vector3d& gyr) {
+  const int j = frame_count_;
+  if (!preintegrations_[j])
+    preintegrations_[j] =
+        std::make_unique<ImuPreintegration>(acc_0_, gyr_0_, Bas_[j], Bgs_[j], imuNoise());
+  if (j != 0) {
+    preintegrations_[j]->push(dt, acc, gyr);
+    if (tmp_preintegration_) tmp_preintegration_->push(dt, acc, gyr);
+    dt_buf_[j].push_back(dt);
+    acc_buf_[j].push_back(acc);
+    gyr_buf_[j].push_back(gyr);
+    // Propagate the newest state: the prediction for the next optimisation.
+    const Eigen::Vector3d a0 = Rs_[j] * (acc_0_ - Bas_[j]) + gravity_;
+    const Eigen::Vector3d w = 0.5 * (gyr_0_ + gyr) - Bgs_[j];
+    Rs_[j] = Rs_[j] * expQuaternion(w * dt).toRotationMatrix();
+    const Eigen::Vector3d a1 = Rs_[j] * (acc - Bas_[j]) + gravity_;
+    const Eigen::Vector3d a = 0.5 * (a0 + a1);
+    Ps_[j] += dt * Vs_[j] + 0.5 * dt * dt * a;
+    Vs_[j] += dt * a;
+  }
+  acc_0_ = acc;
+  gyr_0_ = gyr;
+}
+
+bool Estimator::addFrame(const FeatureFrame& frame, FrameTiming* timing) {
+  const double t = frame.t();
+  consumeImuUpTo(t);
+  if (!has_imu_) {
+    event(EstimatorEvent::Kind::kWaiting, t, "no IMU data before this frame");
+    return false;
+  }
+  marginalization_ = points_.addFrameAndCheckParallax(frame_count_, frame)
+                         ? Marginalization::kOld
+                         : Marginalization::kSecondNew;
+  headers_[frame_count_] = t;
+
+  ImageFrame image;
+  for (const auto& o : frame.points) image.xy1[o.id] = Eigen::Vector3d(o.xy.x(), o.xy.y(), 1.0);
+  image.imu = std::move(tmp_preintegration_);
+  all_frames_[frame.t_ns] = std::move(image);
+  tmp_preintegration_ = std::make_unique<ImuPreintegration>(acc_0_, gyr_0_, Bas_[frame_count_],
+                                                            Bgs_[frame_count_], imuNoise());
+
+  if (status_ == EstimatorStatus::kInitializing) {
+    if (frame_count_ < W_) {
+      ++frame_count_;
+      // The new slot starts from the previous frame's state.
+      Ps_[frame_count_] = Ps_[frame_count_ - 1];
+      Vs_[frame_count_] = Vs_[frame_count_ - 1];
+      Rs_[frame_count_] = Rs_[frame_count_ - 1];
+      Bas_[frame_count_] = Bas_[frame_count_ - 1];
+      Bgs_[frame_count_] = Bgs_[frame_count_ - 1];
+      return false;
+    }
+    bool ok = false;
+    if (t - last_init_attempt_ >= options_.init_retry_interval_s) {
+      last_init_attempt_ = t;
+      ScopedStage stage(timing, "initialization");
+      ok = initialize(t);
+    }
+    if (!ok) {
+      slideWindow();
+      return false;
+    }
+    status_ = EstimatorStatus::kTracking;
+    optimize(timing);
+    {
+      ScopedStage stage(timing, "marginalization");
+      marginalize();
+    }
+    slideWindow();
+    points_.removeFailures();
+    last_R_ = Rs_[W_];
+    last_P_ = Ps_[W_];
+  } else {
+    if (points_.lastTrackedCount() < options_.min_tracked_points) {
+      reset(t, "only " + std::to_string(points_.lastTrackedCount()) + " points tracked");
+      return false;
+    }
+    optimize(timing);
+    std::string why;
+    if (detectFailure(&why)) {
+      reset(t, why);
+      return false;
+    }
+    {
+      ScopedStage stage(timing, "marginalization");
+      marginalize();
+    }
+    slideWindow();
+    points_.removeFailures();
+    last_R_ = Rs_[W_];
+    last_P_ = Ps_[W_];
+  }
+  // Output continuity: after a reset, anchor the new world frame on the last output pose.
+  if (align_output_after_reset_) {
+    align_output_after_reset_ = false;
+    out_yaw_ = yawOf(last_output_.q.toRotationMatrix()) - yawOf(Rs_[W_]);
+    out_from_ = Ps_[W_];
+    out_to_ = last_output_.p;
+  }
+  last_output_ = latestState();
+  have_output_ = true;
+  return true;
+}
+
+bool Estimator::detectFailure(std::string* why) const {
+  auto fail = [&](const std::string& w) {
+    *why = w;
+    return true;
+  };
+  if (!Ps_[W_].allFinite() || !Vs_[W_].allFinite() || !Rs_[W_].allFinite())
+    return fail("the solution is not finite");
+  if (Bas_[W_].norm() > options_.max_accel_bias)
+    return fail("accelerometer bias estimate " + std::to_string(Bas_[W_].norm()) +
+                " m/s^2 too large");
+  if (Bgs_[W_].norm() > options_.max_gyro_bias)
+    return fail("gyroscope bias estimate " + std::to_string(Bgs_[W_].norm()) + " rad/s too large");
+  if ((Ps_[W_] - last_P_).norm() > options_.max_translation_jump_m)
+    return fail("position jumped " + std::to_string((Ps_[W_] - last_P_).norm()) +
+                " m in one frame");
+  if (std::abs(Ps_[W_].z() - last_P_.z()) > options_.max_z_jump_m)
+    return fail("height jumped " + std::to_string(std::abs(Ps_[W_].z() - last_P_.z())) +
+                " m in one frame");
+  const double angle = Eigen::AngleAxisd(last_R_.transpose() * Rs_[W_]).angle() * 180.0 / M_PI;
+  if (angle > options_.max_rotation_jump_deg)
+    return fail("rotation jumped " + std::to_string(angle) + " deg in one frame");
+  return false;
+}
+
+void Estimator::reset(double t, const std::string& why) {
+  ++reset_count_;
+  logWarn("estimator failure at t=", t, ": ", why, "; resetting and re-initialising");
+  event(EstimatorEvent::Kind::kFailure, t, why);
+  // Keep the latest biases: they are still the best guess after a reset.
+  const Eigen::Vector3d ba = Bas_[W_], bg = Bgs_[W_];
+  clearState();
+  for (int i = 0; i <= W_; ++i) {
+    Bas_[i] = ba.allFinite() && ba.norm() < options_.max_accel_bias ? ba : Eigen::Vector3d::Zero();
+    Bgs_[i] = bg.allFinite() && bg.norm() < options_.max_gyro_bias ? bg : Eigen::Vector3d::Zero();
+  }
+  align_output_after_reset_ = have_output_;
+  event(EstimatorEvent::Kind::kReset, t, "reset: " + why);
+}
+
+void Estimator::slideWindow() {
+  if (marginalization_ == Marginalization::kOld) {
+    const double t0 = headers_[0];
+    back_R0_ = Rs_[0];
+    back_P0_ = Ps_[0];
+    if (frame_count_ == W_) {
+      for (int i = 0; i < W_; ++i) {
+        headers_[i] = headers_[i + 1];
+        Ps_[i] = Ps_[i + 1];
+        Vs_[i] = Vs_[i + 1];
+        Rs_[i] = Rs_[i + 1];
+        Bas_[i] = Bas_[i + 1];
+        Bgs_[i] = Bgs_[i + 1];
+        std::swap(preintegrations_[i], preintegrations_[i + 1]);
+        std::swap(dt_buf_[i], dt_buf_[i + 1]);
+        std::swap(acc_buf_[i], acc_buf_[i + 1]);
+        std::swap(gyr_buf_[i], gyr_buf_[i + 1]);
+      }
+      // The newest slot continues from the newest state.
+      preintegrations_[W_] =
+          std::make_unique<ImuPreintegration>(acc_0_, gyr_0_, Bas_[W_], Bgs_[W_], imuNoise());
+      dt_buf_[W_].clear();
+      acc_buf_[W_].clear();
+      gyr_buf_[W_].clear();
+      // Frames older than the new oldest keyframe are no longer needed for initialisation.
+      // (1 us of slack: t0 went through double seconds and lost a few ns.)
+      const int64_t t0_ns = secToNs(t0) + 1000;
+      all_frames_.erase(all_frames_.begin(), all_frames_.upper_bound(t0_ns));
+      if (status_ == EstimatorStatus::kTracking) {
+        const Eigen::Matrix3d R_c_old = back_R0_ * T_b_c_.linear();
+        const Eigen::Vector3d p_c_old = back_P0_ + back_R0_ * T_b_c_.translation();
+        const Eigen::Matrix3d R_c_new = Rs_[0] * T_b_c_.linear();
+        const Eigen::Vector3d p_c_new = Ps_[0] + Rs_[0] * T_b_c_.translation();
+        points_.removeOldestShiftDepth(R_c_old, p_c_old, R_c_new, p_c_new);
+      } else {
+        points_.removeOldest();
+      }
+    }
+  } else if (frame_count_ == W_) {
+    // Drop the second-newest frame: its IMU data joins the newest frame's interval.
+    for (std::size_t k = 0; k < dt_buf_[W_].size(); ++k) {
+      preintegrations_[W_ - 1]->push(dt_buf_[W_][k], acc_buf_[W_][k], gyr_buf_[W_][k]);
+      dt_buf_[W_ - 1].push_back(dt_buf_[W_][k]);
+      acc_buf_[W_ - 1].push_back(acc_buf_[W_][k]);
+      gyr_buf_[W_ - 1].push_back(gyr_buf_[W_][k]);
+    }
+    headers_[W_ - 1] = headers_[W_];
+    Ps_[W_ - 1] = Ps_[W_];
+    Vs_[W_ - 1] = Vs_[W_];
+    Rs_[W_ - 1] = Rs_[W_];
+    Bas_[W_ - 1] = Bas_[W_];
+    Bgs_[W_ - 1] = Bgs_[W_];
+    preintegrations_[W_] =
+        std::make_unique<ImuPreintegration>(acc_0_, gyr_0_, Bas_[W_], Bgs_[W_], imuNoise());
+    dt_buf_[W_].clear();
+    acc_buf_[W_].clear();
+    gyr_buf_[W_].clear();
+    points_.removeSecondNewest(frame_count_);
+  }
+}
+
+BodyState Estimator::toOutput(const BodyState& s) const {
+  const Eigen::Matrix3d Rz =
+      Eigen::AngleAxisd(out_yaw_, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  BodyState o = s;
+  o.p = Rz * (s.p - out_from_) + out_to_;
+  o.q = Eigen::Quaterniond(Rz * s.q.toRotationMatrix()).normalized();
+  o.v = Rz * s.v;
+  return o;
+}
+
+BodyState Estimator::latestState() const {
+  BodyState s;
+  s.t = headers_[frame_count_];
+  s.p = Ps_[frame_count_];
+  s.q = Eigen::Quaterniond(Rs_[frame_count_]).normalized();
+  s.v = Vs_[frame_count_];
+  s.ba = Bas_[frame_count_];
+  s.bg = Bgs_[frame_count_];
+  return toOutput(s);
+}
+
+std::vector<BodyState, Eigen::aligned_allocator<BodyState>> Estimator::windowStates() const {
+  std::vector<BodyState, Eigen::aligned_allocator<BodyState>> out;
+  for (int i = 0; i <= frame_count_; ++i) {
+    BodyState s;
+    s.t = headers_[i];
+    s.p = Ps_[i];
+    s.q = Eigen::Quaterniond(Rs_[i]).normalized();
+    s.v = Vs_[i];
+    s.ba = Bas_[i];
+    s.bg = Bgs_[i];
+    out.push_back(toOutput(s));
+  }
+  return out;
+}
+
+std::map<int, Eigen::Vector3d> Estimator::landmarkPositions() const {
+  std::map<int, Eigen::Vector3d> out;
+  if (status_ != EstimatorStatus::kTracking) return out;
+  for (const auto& [id, l] : points_.landmarks()) {
+    if (!l.usable(W_) || l.depth <= 0) continue;
+    const int i = l.start_frame;
+    const Eigen::Vector3d p_c = l.sightings.front().xy1 * l.depth;
+    BodyState s;
+    s.p = Rs_[i] * (T_b_c_ * p_c) + Ps_[i];
+    out[id] = toOutput(s).p;
+  }
+  return out;
+}
+
+}  // namespace alvio

@@ -1,0 +1,216 @@
+// Initialisation of the estimator: up-to-scale visual structure from motion
+// over the window, then alignment with the IMU for scale, gravity, velocities
+// and gyroscope bias. Reasons for waiting are reported as events.
+#include <cmath>
+#include <sstream>
+
+#include "alvio/common/logging.h"
+#include "alvio/common/rotation.h"
+#include "alvio/estimator/estimator.h"
+#include "alvio/estimator/initialization/structure_from_motion.h"
+#include "alvio/estimator/initialization/visual_inertial_alignment.h"
+
+namespace alvio {
+
+bool Estimator::initialize(double t) {
+  if (!initialStructure(t)) return false;
+  if (!alignWithImu(t)) return false;
+  EstimatorEvent e;
+  e.kind = EstimatorEvent::Kind::kInitialized;
+  e.t = t;
+  e.window = windowStates();
+  e.scale = init_scale_;
+  e.message = "initialised";
+  events_.push_back(std::move(e));
+  last_wait_reason_.clear();
+  return true;
+}
+
+namespace {
+// Log a reason for waiting once, not on every attempt.
+void waitFor(std::string* last, std::vector<EstimatorEvent>* events, double t,
+             const std::string& why) {
+  if (*last == why) return;
+  *last = why;
+  logInfo("initialisation waits: ", why);
+  EstimatorEvent e;
+  e.kind = EstimatorEvent::Kind::kWaiting;
+  e.t = t;
+  e.message = why;
+  events->push_back(std::move(e));
+}
+}  // namespace
+
+bool Estimator::initialStructure(double t) {
+  // Enough accelerometer excitation to observe scale and gravity?
+  {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    std::vector<Eigen::Vector3d> g;
+    for (const auto& [stamp, f] : all_frames_) {
+      if (!f.imu || f.imu->sumDt() <= 0) continue;
+      g.push_back(f.imu->deltaV() / f.imu->sumDt());
+      sum += g.back();
+    }
+    if (g.size() < 2) {
+      waitFor(&last_wait_reason_, &events_, t, "not enough IMU data in the window");
+      return false;
+    }
+    const Eigen::Vector3d mean = sum / g.size();
+    double var = 0;
+    for (const auto& x : g) var += (x - mean).squaredNorm();
+    const double stddev = std::sqrt(var / g.size());
+    if (stddev < 0.25) {
+      std::ostringstream os;
+      os << "IMU excitation too low (acceleration std " << stddev
+         << " m/s^2 < 0.25): move the sensor";
+      waitFor(&last_wait_reason_, &events_, t, os.str());
+      return false;
+    }
+  }
+
+  // A reference frame with enough correspondences and parallax to the newest frame.
+  int ref = -1;
+  Eigen::Matrix3d R_ref_last;
+  Eigen::Vector3d t_ref_last;
+  // Parallax is measured after removing the rotation the gyroscope saw: rotation alone
+  // gives parallax but no baseline, and the essential matrix of such a pair is unreliable.
+  const double min_parallax = options_.init_min_parallax_px / camera_.intrinsics[0];
+  const Eigen::Matrix3d R_b_c = T_b_c_.linear();
+  for (int i = 0; i < W_; ++i) {
+    const auto corr = points_.correspondences(i, W_);
+    if (static_cast<int>(corr.size()) < options_.init_min_correspondences) continue;
+    Eigen::Quaterniond q_bi_bw = Eigen::Quaterniond::Identity();
+    for (int k = i + 1; k <= W_; ++k) q_bi_bw = q_bi_bw * preintegrations_[k]->deltaQ();
+    const Eigen::Matrix3d R_ci_cw = R_b_c.transpose() * q_bi_bw.toRotationMatrix() * R_b_c;
+    double parallax = 0;
+    for (const auto& [a, b] : corr) {
+      const Eigen::Vector3d b_in_i = R_ci_cw * b;
+      parallax += (a.head<2>() - b_in_i.head<2>() / b_in_i.z()).norm();
+    }
+    parallax /= corr.size();
+    if (parallax < min_parallax) continue;
+    if (relativePoseFromEssential(corr, &R_ref_last, &t_ref_last)) {
+      ref = i;
+      break;
+    }
+  }
+  if (ref < 0) {
+    waitFor(&last_wait_reason_, &events_, t,
+            "not enough parallax or correspondences between the window's frames");
+    return false;
+  }
+
+  // Structure from motion over the keyframes of the window.
+  std::vector<SfmTrack> tracks;
+  for (const auto& [id, l] : points_.landmarks()) {
+    SfmTrack track;
+    track.id = id;
+    for (std::size_t k = 0; k < l.sightings.size(); ++k)
+      track.sightings.emplace_back(l.start_frame + static_cast<int>(k),
+                                   l.sightings[k].xy1.head<2>());
+    tracks.push_back(std::move(track));
+  }
+  SfmResult sfm;
+  if (!reconstructStructure(frame_count_ + 1, ref, R_ref_last, t_ref_last, tracks, &sfm)) {
+    waitFor(&last_wait_reason_, &events_, t, "visual structure from motion failed");
+    marginalization_ = Marginalization::kOld;
+    return false;
+  }
+
+  // Every frame since the oldest keyframe: keyframes from SfM, the others by PnP.
+  const Eigen::Matrix3d R_c_b = T_b_c_.linear().transpose();
+  int key = 0;
+  for (auto& [stamp, f] : all_frames_) {
+    if (key <= frame_count_ && std::abs(nsToSec(stamp) - headers_[key]) < 1e-6) {
+      f.is_keyframe = true;
+      f.R = sfm.q_ref_c[key].toRotationMatrix() * R_c_b;
+      f.T = sfm.t_ref_c[key];
+      ++key;
+      continue;
+    }
+    f.is_keyframe = false;
+    // Start from the pose of the next keyframe (the frame lies before it).
+    const int guess = std::min(key, frame_count_);
+    Eigen::Matrix3d R_ref_c = sfm.q_ref_c[guess].toRotationMatrix();
+    Eigen::Vector3d t_ref_c = sfm.t_ref_c[guess];
+    std::vector<Eigen::Vector3d> pts;
+    std::vector<Eigen::Vector2d> obs;
+    for (const auto& [id, xy1] : f.xy1) {
+      const auto it = sfm.points.find(id);
+      if (it == sfm.points.end()) continue;
+      pts.push_back(it->second);
+      obs.push_back(xy1.head<2>());
+    }
+    if (pts.size() < 6 || !cameraPoseFromPoints(pts, obs, &R_ref_c, &t_ref_c)) {
+      waitFor(&last_wait_reason_, &events_, t, "PnP failed for a non-keyframe frame");
+      return false;
+    }
+    f.R = R_ref_c * R_c_b;
+    f.T = t_ref_c;
+  }
+  return true;
+}
+
+bool Estimator::alignWithImu(double t) {
+  std::vector<AlignmentFrame> frames;
+  for (auto& [stamp, f] : all_frames_) {
+    AlignmentFrame a;
+    a.R_c0_b = f.R;
+    a.p_c0_c = f.T;
+    a.imu = frames.empty() ? nullptr : f.imu.get();
+    frames.push_back(a);
+  }
+  if (logLevel() <= LogLevel::kDebug) {
+    for (std::size_t k = 1; k < frames.size(); ++k) {
+      const Eigen::Quaterniond q_vis(frames[k - 1].R_c0_b.transpose() * frames[k].R_c0_b);
+      logDebug("align: frame ", k, " dt ", frames[k].imu->sumDt(), " visual-vs-imu rotation ",
+               q_vis.angularDistance(frames[k].imu->deltaQ()) * 180 / M_PI, " deg, visual step ",
+               (frames[k].p_c0_c - frames[k - 1].p_c0_c).norm());
+    }
+  }
+  AlignmentResult result;
+  if (!alignVisualInertial(frames, T_b_c_.translation(), imu_options_.gravity_magnitude, &result)) {
+    waitFor(&last_wait_reason_, &events_, t, "visual-inertial alignment failed: " + result.failure);
+    return false;
+  }
+
+  // Keyframe states in the c0 frame, metric, then rotated so gravity points down -z.
+  for (int i = 0; i <= frame_count_; ++i) {
+    const ImageFrame& f = all_frames_.lower_bound(secToNs(headers_[i]) - 1000)->second;
+    Rs_[i] = f.R;
+    Ps_[i] = f.T;
+    Bgs_[i] = result.gyro_bias;
+    Bas_[i].setZero();
+  }
+  for (int i = 0; i <= W_; ++i)
+    if (preintegrations_[i]) preintegrations_[i]->repropagate(Eigen::Vector3d::Zero(), Bgs_[i]);
+  const double s = result.scale;
+  init_scale_ = s;
+  const Eigen::Vector3d t_b_c = T_b_c_.translation();
+  for (int i = frame_count_; i >= 0; --i)
+    Ps_[i] = s * Ps_[i] - Rs_[i] * t_b_c - (s * Ps_[0] - Rs_[0] * t_b_c);
+  // Velocities: the alignment gives them in each frame's body frame, for every frame.
+  int all_index = 0, key = 0;
+  for (const auto& [stamp, f] : all_frames_) {
+    if (key <= frame_count_ && f.is_keyframe) Vs_[key++] = f.R * result.velocities_body[all_index];
+    ++all_index;
+  }
+  const Eigen::Matrix3d R0 = gravityAlignedRotation(result.gravity_c0);
+  const double yaw = yawOf(R0 * Rs_[0]);
+  const Eigen::Matrix3d rot =
+      Eigen::AngleAxisd(-yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix() * R0;
+  for (int i = 0; i <= frame_count_; ++i) {
+    Ps_[i] = rot * Ps_[i];
+    Rs_[i] = rot * Rs_[i];
+    Vs_[i] = rot * Vs_[i];
+  }
+  // Depths: triangulate in the metric, gravity-aligned window.
+  points_.clearDepths();
+  std::vector<Eigen::Vector3d> P(Ps_.begin(), Ps_.end());
+  std::vector<Eigen::Matrix3d> R(Rs_.begin(), Rs_.end());
+  points_.triangulate(P, R, T_b_c_);
+  logInfo("initialised at t=", t, ": scale ", s, ", gyroscope bias ", result.gyro_bias.transpose());
+  return true;
+}
+
+}  // namespace alvio

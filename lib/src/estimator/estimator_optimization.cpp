@@ -1,0 +1,224 @@
+// The per-frame optimisation of the sliding window and the marginalisation
+// that follows it.
+#include <ceres/loss_function.h>
+#include <ceres/problem.h>
+#include <ceres/solver.h>
+
+#include <cmath>
+
+#include "alvio/common/logging.h"
+#include "alvio/common/rotation.h"
+#include "alvio/estimator/estimator.h"
+#include "alvio/estimator/factors/imu_factor.h"
+#include "alvio/estimator/factors/marginalization.h"
+#include "alvio/estimator/factors/point_projection_factor.h"
+#include "alvio/estimator/pose_manifold.h"
+
+namespace alvio {
+namespace {
+
+// IMU factors over longer gaps are meaningless (the preintegration drifts).
+constexpr double kMaxImuFactorSpan = 10.0;
+
+ceres::LossFunction* makeLoss(const EstimatorOptions& o) {
+  if (o.robust_loss == "huber") return new ceres::HuberLoss(o.robust_loss_scale);
+  if (o.robust_loss == "cauchy") return new ceres::CauchyLoss(o.robust_loss_scale);
+  return nullptr;
+}
+
+}  // namespace
+
+void Estimator::statesToParameters() {
+  for (int i = 0; i <= W_; ++i) {
+    Eigen::Map<Eigen::Vector3d>{para_pose_[i].data()} = Ps_[i];
+    Eigen::Map<Eigen::Quaterniond>{para_pose_[i].data() + 3} =
+        Eigen::Quaterniond(Rs_[i]).normalized();
+    Eigen::Map<Eigen::Matrix<double, 9, 1>> sb(para_speed_bias_[i].data());
+    sb << Vs_[i], Bas_[i], Bgs_[i];
+  }
+  const Eigen::VectorXd inv = points_.inverseDepths();
+  para_inv_depth_.assign(inv.data(), inv.data() + inv.size());
+}
+
+void Estimator::parametersToStates() {
+  // The window is only constrained up to a yaw and a translation (plus the prior): keep the
+  // oldest keyframe's yaw and position where they were, so the output does not wander.
+  const Eigen::Vector3d origin_P0 = Ps_[0];
+  const double origin_yaw = yawOf(Rs_[0]);
+  const Eigen::Matrix3d R0_new =
+      Eigen::Quaterniond(para_pose_[0][6], para_pose_[0][3], para_pose_[0][4], para_pose_[0][5])
+          .normalized()
+          .toRotationMatrix();
+  Eigen::Matrix3d rot_diff =
+      Eigen::AngleAxisd(origin_yaw - yawOf(R0_new), Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  // Near pitch +-90 deg yaw is ill-defined: rotate by the full difference instead.
+  const double pitch = std::asin(std::clamp(-R0_new(2, 0), -1.0, 1.0)) * 180.0 / M_PI;
+  if (std::abs(std::abs(pitch) - 90.0) < 1.0) rot_diff = Rs_[0] * R0_new.transpose();
+  const Eigen::Vector3d P0_new(para_pose_[0][0], para_pose_[0][1], para_pose_[0][2]);
+  for (int i = 0; i <= W_; ++i) {
+    const Eigen::Quaterniond q(para_pose_[i][6], para_pose_[i][3], para_pose_[i][4],
+                               para_pose_[i][5]);
+    Rs_[i] = rot_diff * q.normalized().toRotationMatrix();
+    const Eigen::Vector3d p(para_pose_[i][0], para_pose_[i][1], para_pose_[i][2]);
+    Ps_[i] = rot_diff * (p - P0_new) + origin_P0;
+    const Eigen::Map<const Eigen::Matrix<double, 9, 1>> sb(para_speed_bias_[i].data());
+    Vs_[i] = rot_diff * sb.segment<3>(0);
+    Bas_[i] = sb.segment<3>(3);
+    Bgs_[i] = sb.segment<3>(6);
+  }
+  points_.setInverseDepths(
+      Eigen::Map<const Eigen::VectorXd>(para_inv_depth_.data(), para_inv_depth_.size()));
+}
+
+void Estimator::optimize(FrameTiming* timing) {
+  {
+    ScopedStage stage(timing, "triangulation");
+    std::vector<Eigen::Vector3d> P(Ps_.begin(), Ps_.end());
+    std::vector<Eigen::Matrix3d> R(Rs_.begin(), Rs_.end());
+    points_.triangulate(P, R, T_b_c_);
+  }
+  ScopedStage stage(timing, "optimization");
+  statesToParameters();
+  ceres::Problem::Options problem_options;
+  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem problem(problem_options);
+  std::unique_ptr<ceres::LossFunction> loss(makeLoss(options_));
+  auto* pose_manifold = new PoseManifold();  // shared by all pose blocks, owned by the problem
+  for (int i = 0; i <= frame_count_; ++i) {
+    problem.AddParameterBlock(para_pose_[i].data(), kPoseSize, pose_manifold);
+    problem.AddParameterBlock(para_speed_bias_[i].data(), kSpeedBiasSize);
+  }
+  if (last_marginalization_)
+    problem.AddResidualBlock(new MarginalizationFactor(last_marginalization_), nullptr,
+                             last_marginalization_blocks_);
+  for (int i = 0; i < frame_count_; ++i) {
+    const int j = i + 1;
+    if (preintegrations_[j]->sumDt() > kMaxImuFactorSpan) continue;
+    problem.AddResidualBlock(new ImuFactor(preintegrations_[j].get(), gravity_), nullptr,
+                             para_pose_[i].data(), para_speed_bias_[i].data(), para_pose_[j].data(),
+                             para_speed_bias_[j].data());
+  }
+  const double sqrt_info = camera_.intrinsics[0] / options_.point_sigma_px;
+  int index = -1, residuals = 0;
+  for (const auto& [id, l] : points_.landmarks()) {
+    if (!l.usable(W_)) continue;
+    ++index;
+    const int i = l.start_frame;
+    const Eigen::Vector2d obs_i = l.sightings.front().xy1.head<2>();
+    for (std::size_t k = 1; k < l.sightings.size(); ++k) {
+      const int j = i + static_cast<int>(k);
+      problem.AddResidualBlock(
+          new PointProjectionFactor(obs_i, l.sightings[k].xy1.head<2>(), T_b_c_, sqrt_info),
+          loss.get(), para_pose_[i].data(), para_pose_[j].data(), &para_inv_depth_[index]);
+      ++residuals;
+    }
+  }
+  last_point_residuals_ = residuals;
+
+  ceres::Solver::Options options;
+  options.linear_solver_type = ceres::DENSE_SCHUR;
+  options.trust_region_strategy_type = ceres::DOGLEG;
+  options.max_num_iterations = options_.max_iterations;
+  options.num_threads = options_.num_threads;
+  ceres::Solver::Summary summary;
+  ceres::Solve(options, &problem, &summary);
+  last_iterations_ = static_cast<int>(summary.iterations.size());
+  parametersToStates();
+  removeReprojectionOutliers();
+}
+
+void Estimator::removeReprojectionOutliers() {
+  // Mean reprojection error of each landmark over the window, in pixels.
+  const double f = camera_.intrinsics[0];
+  std::vector<int> outliers;
+  for (const auto& [id, l] : points_.landmarks()) {
+    if (!l.usable(W_) || l.depth <= 0) continue;
+    const int i = l.start_frame;
+    const Eigen::Vector3d p_w = Rs_[i] * (T_b_c_ * (l.sightings.front().xy1 * l.depth)) + Ps_[i];
+    double err = 0;
+    int n = 0;
+    for (std::size_t k = 1; k < l.sightings.size(); ++k) {
+      const int j = i + static_cast<int>(k);
+      const Eigen::Vector3d p_c = T_b_c_.inverse() * (Rs_[j].transpose() * (p_w - Ps_[j]));
+      err += (p_c.head<2>() / p_c.z() - l.sightings[k].xy1.head<2>()).norm() * f;
+      ++n;
+    }
+    if (n > 0 && err / n > options_.outlier_reprojection_px) outliers.push_back(id);
+  }
+  points_.removeIds(outliers);
+}
+
+void Estimator::marginalize() {
+  statesToParameters();
+  if (marginalization_ == Marginalization::kOld) {
+    auto info = std::make_shared<MarginalizationInfo>();
+    if (last_marginalization_) {
+      std::vector<int> drop;
+      for (std::size_t k = 0; k < last_marginalization_blocks_.size(); ++k)
+        if (last_marginalization_blocks_[k] == para_pose_[0].data() ||
+            last_marginalization_blocks_[k] == para_speed_bias_[0].data())
+          drop.push_back(static_cast<int>(k));
+      info->addResidualBlock(new MarginalizationFactor(last_marginalization_), nullptr,
+                             last_marginalization_blocks_, drop);
+    }
+    if (preintegrations_[1]->sumDt() < kMaxImuFactorSpan)
+      info->addResidualBlock(new ImuFactor(preintegrations_[1].get(), gravity_), nullptr,
+                             {para_pose_[0].data(), para_speed_bias_[0].data(),
+                              para_pose_[1].data(), para_speed_bias_[1].data()},
+                             {0, 1});
+    const double sqrt_info = camera_.intrinsics[0] / options_.point_sigma_px;
+    int index = -1;
+    for (const auto& [id, l] : points_.landmarks()) {
+      if (!l.usable(W_)) continue;
+      ++index;
+      if (l.start_frame != 0) continue;
+      const Eigen::Vector2d obs_i = l.sightings.front().xy1.head<2>();
+      for (std::size_t k = 1; k < l.sightings.size(); ++k)
+        info->addResidualBlock(
+            new PointProjectionFactor(obs_i, l.sightings[k].xy1.head<2>(), T_b_c_, sqrt_info),
+            makeLoss(options_),
+            {para_pose_[0].data(), para_pose_[k].data(), &para_inv_depth_[index]}, {0, 2});
+    }
+    if (!info->marginalize()) {
+      last_marginalization_.reset();
+      last_marginalization_blocks_.clear();
+      return;
+    }
+    std::map<double*, double*> shift;
+    for (int i = 1; i <= W_; ++i) {
+      shift[para_pose_[i].data()] = para_pose_[i - 1].data();
+      shift[para_speed_bias_[i].data()] = para_speed_bias_[i - 1].data();
+    }
+    last_marginalization_blocks_ = info->keptBlocks(shift);
+    last_marginalization_ = info;
+    return;
+  }
+  // Dropping the second-newest frame: only the prior can involve it.
+  if (!last_marginalization_) return;
+  std::vector<int> drop;
+  for (std::size_t k = 0; k < last_marginalization_blocks_.size(); ++k)
+    if (last_marginalization_blocks_[k] == para_pose_[W_ - 1].data())
+      drop.push_back(static_cast<int>(k));
+  if (drop.empty()) return;
+  auto info = std::make_shared<MarginalizationInfo>();
+  info->addResidualBlock(new MarginalizationFactor(last_marginalization_), nullptr,
+                         last_marginalization_blocks_, drop);
+  if (!info->marginalize()) {
+    last_marginalization_.reset();
+    last_marginalization_blocks_.clear();
+    return;
+  }
+  std::map<double*, double*> shift;
+  for (int i = 0; i <= W_; ++i) {
+    if (i == W_ - 1) continue;
+    double* to_pose = i == W_ ? para_pose_[W_ - 1].data() : para_pose_[i].data();
+    double* to_sb = i == W_ ? para_speed_bias_[W_ - 1].data() : para_speed_bias_[i].data();
+    shift[para_pose_[i].data()] = to_pose;
+    shift[para_speed_bias_[i].data()] = to_sb;
+  }
+  shift[para_speed_bias_[W_ - 1].data()] = para_speed_bias_[W_ - 1].data();
+  last_marginalization_blocks_ = info->keptBlocks(shift);
+  last_marginalization_ = info;
+}
+
+}  // namespace alvio

@@ -1,0 +1,42 @@
+#include "alvio/estimator/estimator_options.h"
+
+#include "alvio/common/error.h"
+#include "alvio/config/yaml_reader.h"
+
+namespace alvio {
+
+EstimatorOptions EstimatorOptions::load(const YamlReader& yaml, const std::string& prefix) {
+  EstimatorOptions o;
+  const std::string p = prefix + ".";
+  o.window_size = yaml.getInt(p + "window_size", o.window_size);
+  o.keyframe_parallax_px = yaml.getDouble(p + "keyframe_parallax_px", o.keyframe_parallax_px);
+  o.max_iterations = yaml.getInt(p + "max_iterations", o.max_iterations);
+  o.num_threads = yaml.getInt(p + "num_threads", o.num_threads);
+  o.point_sigma_px = yaml.getDouble(p + "point_sigma_px", o.point_sigma_px);
+  o.robust_loss = yaml.getString(p + "robust_loss", o.robust_loss);
+  o.robust_loss_scale = yaml.getDouble(p + "robust_loss_scale", o.robust_loss_scale);
+  o.outlier_reprojection_px =
+      yaml.getDouble(p + "outlier_reprojection_px", o.outlier_reprojection_px);
+  o.imu_noise_scale = yaml.getDouble(p + "imu_noise_scale", o.imu_noise_scale);
+  o.init_min_parallax_px = yaml.getDouble(p + "init_min_parallax_px", o.init_min_parallax_px);
+  o.init_min_correspondences =
+      yaml.getInt(p + "init_min_correspondences", o.init_min_correspondences);
+  o.init_retry_interval_s = yaml.getDouble(p + "init_retry_interval_s", o.init_retry_interval_s);
+  o.min_tracked_points = yaml.getInt(p + "min_tracked_points", o.min_tracked_points);
+  o.max_accel_bias = yaml.getDouble(p + "max_accel_bias", o.max_accel_bias);
+  o.max_gyro_bias = yaml.getDouble(p + "max_gyro_bias", o.max_gyro_bias);
+  o.max_translation_jump_m = yaml.getDouble(p + "max_translation_jump_m", o.max_translation_jump_m);
+  o.max_z_jump_m = yaml.getDouble(p + "max_z_jump_m", o.max_z_jump_m);
+  o.max_rotation_jump_deg = yaml.getDouble(p + "max_rotation_jump_deg", o.max_rotation_jump_deg);
+  if (o.window_size < 4) throw Error(yaml.where(p + "window_size") + " must be at least 4");
+  if (o.max_iterations < 1) throw Error(yaml.where(p + "max_iterations") + " must be at least 1");
+  if (o.num_threads < 1) throw Error(yaml.where(p + "num_threads") + " must be at least 1");
+  if (o.point_sigma_px <= 0) throw Error(yaml.where(p + "point_sigma_px") + " must be positive");
+  if (o.imu_noise_scale <= 0) throw Error(yaml.where(p + "imu_noise_scale") + " must be positive");
+  if (o.robust_loss != "cauchy" && o.robust_loss != "huber" && o.robust_loss != "none")
+    throw Error(yaml.where(p + "robust_loss") + ": unknown loss '" + o.robust_loss +
+                "' (expected cauchy, huber or none)");
+  return o;
+}
+
+}  // namespace alvio

@@ -1,0 +1,190 @@
+#include "alvio/estimator/point_landmarks.h"
+
+#include <Eigen/SVD>
+
+namespace alvio {
+
+namespace {
+constexpr double kDefaultDepth = 5.0;  // metres; for landmarks re-anchored behind the camera
+}
+
+bool PointLandmarks::addFrameAndCheckParallax(int frame_index, const FeatureFrame& frame) {
+  last_track_num_ = 0;
+  for (const auto& o : frame.points) {
+    PointSighting s;
+    s.xy1 = Eigen::Vector3d(o.xy.x(), o.xy.y(), 1.0);
+    s.px = o.px;
+    s.velocity = o.velocity;
+    auto it = landmarks_.find(o.id);
+    // Tracks are continuous; an ID that reappears after a gap starts a new landmark.
+    if (it != landmarks_.end() && it->second.endFrame() != frame_index - 1) {
+      landmarks_.erase(it);
+      it = landmarks_.end();
+    }
+    if (it == landmarks_.end()) {
+      PointLandmark l;
+      l.id = o.id;
+      l.start_frame = frame_index;
+      l.sightings.push_back(s);
+      landmarks_.emplace(o.id, std::move(l));
+    } else {
+      it->second.sightings.push_back(s);
+      ++last_track_num_;
+    }
+  }
+  if (frame_index < 2 || last_track_num_ < 20) return true;
+  // Mean parallax between the two previous frames of points seen in both.
+  double sum = 0;
+  int count = 0;
+  for (const auto& [id, l] : landmarks_) {
+    if (l.start_frame <= frame_index - 2 && l.endFrame() >= frame_index - 1) {
+      const Eigen::Vector3d& a = l.sightings[frame_index - 2 - l.start_frame].xy1;
+      const Eigen::Vector3d& b = l.sightings[frame_index - 1 - l.start_frame].xy1;
+      sum += (a.head<2>() - b.head<2>()).norm();
+      ++count;
+    }
+  }
+  return count == 0 || sum / count >= min_parallax_;
+}
+
+std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> PointLandmarks::correspondences(
+    int a, int b) const {
+  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> out;
+  for (const auto& [id, l] : landmarks_)
+    if (l.start_frame <= a && l.endFrame() >= b)
+      out.emplace_back(l.sightings[a - l.start_frame].xy1, l.sightings[b - l.start_frame].xy1);
+  return out;
+}
+
+void PointLandmarks::triangulate(const std::vector<Eigen::Vector3d>& P,
+                                 const std::vector<Eigen::Matrix3d>& R,
+                                 const Eigen::Isometry3d& T_b_c) {
+  const Eigen::Matrix3d R_b_c = T_b_c.linear();
+  const Eigen::Vector3d t_b_c = T_b_c.translation();
+  for (auto& [id, l] : landmarks_) {
+    if (!l.usable(window_size_) || l.depth > 0) continue;
+    // Camera poses relative to the anchor camera; linear triangulation (DLT) over all sightings.
+    const int i0 = l.start_frame;
+    const Eigen::Vector3d t0 = P[i0] + R[i0] * t_b_c;
+    const Eigen::Matrix3d R0 = R[i0] * R_b_c;
+    Eigen::MatrixXd A(2 * l.sightings.size(), 4);
+    for (std::size_t k = 0; k < l.sightings.size(); ++k) {
+      const int i = i0 + static_cast<int>(k);
+      const Eigen::Vector3d t1 = P[i] + R[i] * t_b_c;
+      const Eigen::Matrix3d R1 = R[i] * R_b_c;
+      // Pose of anchor-frame points in camera i: x_i = R^T (x_0 - t).
+      const Eigen::Vector3d t = R0.transpose() * (t1 - t0);
+      const Eigen::Matrix3d Rr = R0.transpose() * R1;
+      Eigen::Matrix<double, 3, 4> Pm;
+      Pm.leftCols<3>() = Rr.transpose();
+      Pm.rightCols<1>() = -Rr.transpose() * t;
+      const Eigen::Vector3d f = l.sightings[k].xy1.normalized();
+      A.row(2 * k) = f[0] * Pm.row(2) - f[2] * Pm.row(0);
+      A.row(2 * k + 1) = f[1] * Pm.row(2) - f[2] * Pm.row(1);
+    }
+    const Eigen::Vector4d X =
+        Eigen::JacobiSVD<Eigen::MatrixXd>(A, Eigen::ComputeThinV).matrixV().col(3);
+    const double depth = X[2] / X[3];
+    l.depth = depth < 0.1 ? kDefaultDepth : depth;
+    l.state = PointLandmark::State::kTriangulated;
+  }
+}
+
+int PointLandmarks::usableCount() const {
+  int n = 0;
+  for (const auto& [id, l] : landmarks_) n += l.usable(window_size_);
+  return n;
+}
+
+Eigen::VectorXd PointLandmarks::inverseDepths() const {
+  Eigen::VectorXd v(usableCount());
+  int k = 0;
+  for (const auto& [id, l] : landmarks_)
+    if (l.usable(window_size_)) v[k++] = 1.0 / l.depth;
+  return v;
+}
+
+void PointLandmarks::setInverseDepths(const Eigen::VectorXd& inv) {
+  int k = 0;
+  for (auto& [id, l] : landmarks_) {
+    if (!l.usable(window_size_)) continue;
+    l.depth = 1.0 / inv[k++];
+    l.state = l.depth < 0 ? PointLandmark::State::kFailed : PointLandmark::State::kTriangulated;
+  }
+}
+
+void PointLandmarks::clearDepths() {
+  for (auto& [id, l] : landmarks_) {
+    l.depth = -1;
+    l.state = PointLandmark::State::kNew;
+  }
+}
+
+void PointLandmarks::removeOldestShiftDepth(const Eigen::Matrix3d& R_old,
+                                            const Eigen::Vector3d& p_old,
+                                            const Eigen::Matrix3d& R_new,
+                                            const Eigen::Vector3d& p_new) {
+  for (auto it = landmarks_.begin(); it != landmarks_.end();) {
+    PointLandmark& l = it->second;
+    if (l.start_frame != 0) {
+      --l.start_frame;
+      ++it;
+      continue;
+    }
+    const Eigen::Vector3d xy1 = l.sightings.front().xy1;
+    l.sightings.erase(l.sightings.begin());
+    if (l.sightings.size() < 2) {
+      it = landmarks_.erase(it);
+      continue;
+    }
+    if (l.depth > 0) {
+      const Eigen::Vector3d p_w = R_old * (xy1 * l.depth) + p_old;
+      const Eigen::Vector3d p_c = R_new.transpose() * (p_w - p_new);
+      l.depth = p_c.z() > 0 ? p_c.z() : kDefaultDepth;
+    }
+    ++it;
+  }
+}
+
+void PointLandmarks::removeOldest() {
+  for (auto it = landmarks_.begin(); it != landmarks_.end();) {
+    PointLandmark& l = it->second;
+    if (l.start_frame != 0) {
+      --l.start_frame;
+    } else {
+      l.sightings.erase(l.sightings.begin());
+      if (l.sightings.empty()) {
+        it = landmarks_.erase(it);
+        continue;
+      }
+    }
+    ++it;
+  }
+}
+
+void PointLandmarks::removeSecondNewest(int frame_index) {
+  for (auto it = landmarks_.begin(); it != landmarks_.end();) {
+    PointLandmark& l = it->second;
+    if (l.start_frame == frame_index) {
+      --l.start_frame;  // only seen in the newest frame, which takes the dropped slot
+    } else if (l.endFrame() >= frame_index - 1) {
+      l.sightings.erase(l.sightings.begin() + (frame_index - 1 - l.start_frame));
+      if (l.sightings.empty()) {
+        it = landmarks_.erase(it);
+        continue;
+      }
+    }
+    ++it;
+  }
+}
+
+void PointLandmarks::removeFailures() {
+  for (auto it = landmarks_.begin(); it != landmarks_.end();)
+    it = it->second.state == PointLandmark::State::kFailed ? landmarks_.erase(it) : std::next(it);
+}
+
+void PointLandmarks::removeIds(const std::vector<int>& ids) {
+  for (int id : ids) landmarks_.erase(id);
+}
+
+}  // namespace alvio

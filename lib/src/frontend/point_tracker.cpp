@@ -1,0 +1,200 @@
+#include "alvio/frontend/point_tracker.h"
+
+#include <algorithm>
+#include <numeric>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/video/tracking.hpp>
+#include <unordered_map>
+
+#include "alvio/common/error.h"
+#include "alvio/config/yaml_reader.h"
+
+namespace alvio {
+
+PointTrackerOptions PointTrackerOptions::load(const YamlReader& yaml, const std::string& prefix) {
+  PointTrackerOptions o;
+  const std::string p = prefix + ".";
+  o.max_features = yaml.getInt(p + "max_features", o.max_features);
+  o.min_distance_px = yaml.getInt(p + "min_distance_px", o.min_distance_px);
+  o.quality_level = yaml.getDouble(p + "quality_level", o.quality_level);
+  o.ransac_threshold_px = yaml.getDouble(p + "ransac_threshold_px", o.ransac_threshold_px);
+  o.equalize = yaml.getBool(p + "equalize", o.equalize);
+  o.klt_window = yaml.getInt(p + "klt_window", o.klt_window);
+  o.klt_levels = yaml.getInt(p + "klt_levels", o.klt_levels);
+  o.forward_backward_check = yaml.getBool(p + "forward_backward_check", o.forward_backward_check);
+  o.forward_backward_max_px =
+      yaml.getDouble(p + "forward_backward_max_px", o.forward_backward_max_px);
+  if (o.max_features < 8) throw Error(yaml.where(p + "max_features") + " must be at least 8");
+  if (o.min_distance_px < 1) throw Error(yaml.where(p + "min_distance_px") + " must be at least 1");
+  if (o.klt_window < 5 || o.klt_window % 2 == 0)
+    throw Error(yaml.where(p + "klt_window") + " must be an odd number >= 5");
+  return o;
+}
+
+PointTracker::PointTracker(const PointTrackerOptions& options,
+                           std::shared_ptr<const CameraModel> camera)
+    : options_(options), camera_(std::move(camera)), clahe_(cv::createCLAHE(3.0, cv::Size(8, 8))) {}
+
+void PointTracker::reset() {
+  prev_img_.release();
+  pts_.clear();
+  ids_.clear();
+  track_counts_.clear();
+  prev_xy_.clear();
+  prev_ids_.clear();
+}
+
+namespace {
+template <typename T>
+void keep(std::vector<T>* v, const std::vector<uchar>& status) {
+  std::size_t j = 0;
+  for (std::size_t i = 0; i < v->size(); ++i)
+    if (status[i]) (*v)[j++] = (*v)[i];
+  v->resize(j);
+}
+}  // namespace
+
+void PointTracker::rejectWithFundamental(std::vector<cv::Point2f>* prev,
+                                         std::vector<cv::Point2f>* cur, std::vector<int>* ids,
+                                         std::vector<int>* counts) const {
+  if (cur->size() < 8) return;
+  // RANSAC in a virtual undistorted pinhole image so the threshold is in pixels.
+  const double f = camera_->fx(), cx = camera_->cx(), cy = camera_->cy();
+  std::vector<cv::Point2f> un_prev(prev->size()), un_cur(cur->size());
+  for (std::size_t i = 0; i < cur->size(); ++i) {
+    const Eigen::Vector2d a = camera_->undistort({(*prev)[i].x, (*prev)[i].y});
+    const Eigen::Vector2d b = camera_->undistort({(*cur)[i].x, (*cur)[i].y});
+    un_prev[i] = cv::Point2f(f * a.x() + cx, f * a.y() + cy);
+    un_cur[i] = cv::Point2f(f * b.x() + cx, f * b.y() + cy);
+  }
+  std::vector<uchar> status;
+  cv::findFundamentalMat(un_prev, un_cur, cv::FM_RANSAC, options_.ransac_threshold_px, 0.99,
+                         status);
+  if (status.size() != cur->size()) return;  // degenerate: keep all
+  keep(prev, status);
+  keep(cur, status);
+  keep(ids, status);
+  keep(counts, status);
+}
+
+FeatureFrame PointTracker::track(const cv::Mat& gray, int64_t t_ns, FrameTiming* timing) {
+  if (gray.type() != CV_8UC1)
+    throw Error("point tracker: expected an 8-bit single-channel image, got type " +
+                std::to_string(gray.type()));
+  if (gray.cols != camera_->width() || gray.rows != camera_->height())
+    throw Error("point tracker: image is " + std::to_string(gray.cols) + "x" +
+                std::to_string(gray.rows) + " but the camera is " +
+                std::to_string(camera_->width()) + "x" + std::to_string(camera_->height()));
+  FeatureFrame frame;
+  frame.t_ns = t_ns;
+  frame.mean_intensity = cv::mean(gray)[0];
+
+  cv::Mat img;
+  {
+    ScopedStage stage(timing, "preprocess");
+    if (options_.equalize)
+      clahe_->apply(gray, img);
+    else
+      img = gray;
+  }
+
+  {
+    ScopedStage stage(timing, "point_tracking");
+    if (!prev_img_.empty() && !pts_.empty()) {
+      std::vector<cv::Point2f> next;
+      std::vector<uchar> status;
+      std::vector<float> err;
+      const cv::Size win(options_.klt_window, options_.klt_window);
+      cv::calcOpticalFlowPyrLK(prev_img_, img, pts_, next, status, err, win, options_.klt_levels);
+      if (options_.forward_backward_check) {
+        std::vector<cv::Point2f> back = pts_;
+        std::vector<uchar> back_status;
+        cv::calcOpticalFlowPyrLK(
+            img, prev_img_, next, back, back_status, err, win, options_.klt_levels,
+            cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 30, 0.01),
+            cv::OPTFLOW_USE_INITIAL_FLOW);
+        for (std::size_t i = 0; i < status.size(); ++i)
+          status[i] = status[i] && back_status[i] &&
+                      cv::norm(back[i] - pts_[i]) <= options_.forward_backward_max_px;
+      }
+      for (std::size_t i = 0; i < status.size(); ++i)
+        status[i] = status[i] && camera_->inImage({next[i].x, next[i].y}, 1.0);
+      std::vector<cv::Point2f> prev = pts_;
+      keep(&prev, status);
+      keep(&next, status);
+      keep(&ids_, status);
+      keep(&track_counts_, status);
+      rejectWithFundamental(&prev, &next, &ids_, &track_counts_);
+      pts_ = next;
+    } else {
+      pts_.clear();
+      ids_.clear();
+      track_counts_.clear();
+    }
+    for (int& c : track_counts_) ++c;
+  }
+
+  {
+    ScopedStage stage(timing, "point_detection");
+    detectNew(img);
+  }
+
+  // Normalised coordinates and their velocities against the previous frame.
+  std::unordered_map<int, Eigen::Vector2d> prev_xy;
+  for (std::size_t i = 0; i < prev_ids_.size(); ++i) prev_xy[prev_ids_[i]] = prev_xy_[i];
+  const double dt = prev_t_ns_ ? (t_ns - prev_t_ns_) * 1e-9 : 0.0;
+  prev_xy_.clear();
+  prev_ids_.clear();
+  frame.points.reserve(pts_.size());
+  for (std::size_t i = 0; i < pts_.size(); ++i) {
+    PointObservation o;
+    o.id = ids_[i];
+    o.px = Eigen::Vector2d(pts_[i].x, pts_[i].y);
+    o.xy = camera_->undistort(o.px);
+    o.track_count = track_counts_[i];
+    const auto it = prev_xy.find(o.id);
+    if (it != prev_xy.end() && dt > 0) o.velocity = (o.xy - it->second) / dt;
+    frame.points.push_back(o);
+    prev_xy_.push_back(o.xy);
+    prev_ids_.push_back(o.id);
+  }
+  prev_img_ = img;
+  prev_t_ns_ = t_ns;
+  return frame;
+}
+
+void PointTracker::detectNew(const cv::Mat& img) {
+  // Keep the longest-tracked points first, each masking its neighbourhood.
+  std::vector<std::size_t> order(pts_.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return track_counts_[a] > track_counts_[b];
+  });
+  cv::Mat mask(img.size(), CV_8UC1, cv::Scalar(255));
+  std::vector<cv::Point2f> pts;
+  std::vector<int> ids, counts;
+  for (std::size_t i : order) {
+    const cv::Point2f& p = pts_[i];
+    if (mask.at<uchar>(cvRound(p.y), cvRound(p.x)) == 0) continue;
+    pts.push_back(p);
+    ids.push_back(ids_[i]);
+    counts.push_back(track_counts_[i]);
+    cv::circle(mask, p, options_.min_distance_px, 0, -1);
+  }
+  const int wanted = options_.max_features - static_cast<int>(pts.size());
+  if (wanted > 0) {
+    std::vector<cv::Point2f> corners;
+    cv::goodFeaturesToTrack(img, corners, wanted, options_.quality_level, options_.min_distance_px,
+                            mask);
+    for (const auto& c : corners) {
+      pts.push_back(c);
+      ids.push_back(next_id_++);
+      counts.push_back(1);
+    }
+  }
+  pts_ = std::move(pts);
+  ids_ = std::move(ids);
+  track_counts_ = std::move(counts);
+}
+
+}  // namespace alvio

@@ -1,0 +1,185 @@
+#include "alvio/pipeline/offline_runner.h"
+
+#include <deque>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "alvio/common/logging.h"
+#include "alvio/common/progress_bar.h"
+#include "alvio/eval/evaluation_report.h"
+#include "alvio/io/trajectory_io.h"
+#include "alvio/pipeline/vio_pipeline.h"
+
+namespace alvio {
+
+namespace {
+
+// Nearest ground-truth pose (within 20 ms) to time t.
+const StampedPose* nearestPose(const Trajectory& gt, double t) {
+  auto it = std::lower_bound(gt.begin(), gt.end(), t,
+                             [](const StampedPose& p, double v) { return p.t < v; });
+  const StampedPose* best = nullptr;
+  for (auto c : {it, it == gt.begin() ? it : std::prev(it)})
+    if (c != gt.end() && (!best || std::abs(c->t - t) < std::abs(best->t - t))) best = &*c;
+  return best && std::abs(best->t - t) < 0.02 ? best : nullptr;
+}
+
+// First time the ground truth moves faster than 0.1 m/s or turns faster than 10 deg/s.
+double firstMotion(const Trajectory& gt) {
+  for (std::size_t i = 10; i < gt.size(); i += 10) {
+    const double dt = gt[i].t - gt[i - 10].t;
+    if (dt <= 0) continue;
+    const double v = (gt[i].p - gt[i - 10].p).norm() / dt;
+    const double w = gt[i].q.angularDistance(gt[i - 10].q) / dt;
+    if (v > 0.1 || w > 10.0 * M_PI / 180) return gt[i - 10].t;
+  }
+  return gt.empty() ? 0 : gt.front().t;
+}
+
+std::string eventKindName(EstimatorEvent::Kind k) {
+  switch (k) {
+    case EstimatorEvent::Kind::kWaiting:
+      return "waiting";
+    case EstimatorEvent::Kind::kInitialized:
+      return "initialized";
+    case EstimatorEvent::Kind::kFailure:
+      return "failure";
+    case EstimatorEvent::Kind::kReset:
+      return "reset";
+  }
+  return "?";
+}
+
+}  // namespace
+
+InitializationQuality initializationQuality(
+    const std::vector<BodyState, Eigen::aligned_allocator<BodyState>>& window,
+    const Trajectory& gt) {
+  InitializationQuality q;
+  Points3 est, truth;
+  double gravity_err = 0;
+  int n = 0;
+  for (const auto& s : window) {
+    const StampedPose* g = nearestPose(gt, s.t);
+    if (!g) continue;
+    est.push_back(s.p);
+    truth.push_back(g->p);
+    // Gravity direction in the body frame, estimated vs true.
+    const Eigen::Vector3d z_est = s.q.inverse() * Eigen::Vector3d::UnitZ();
+    const Eigen::Vector3d z_gt = g->q.inverse() * Eigen::Vector3d::UnitZ();
+    gravity_err += std::acos(std::clamp(z_est.dot(z_gt), -1.0, 1.0)) * 180.0 / M_PI;
+    ++n;
+  }
+  if (n >= 3) {
+    q.scale_error = std::abs(alignPoints(est, truth, AlignmentMode::kSim3).s - 1.0);
+    q.gravity_error_deg = gravity_err / n;
+  }
+  return q;
+}
+
+RunResult runOffline(SensorSource& source, const Config& config, const RunOptions& options) {
+  namespace fs = std::filesystem;
+  fs::create_directories(options.out_dir);
+  VioPipeline pipeline(config);
+  RunResult result;
+  const auto gt = source.groundTruth();
+  std::ostringstream events_log;
+  const std::size_t total = options.max_frames > 0
+                                ? std::min<std::size_t>(options.max_frames, source.imageCount())
+                                : source.imageCount();
+  ProgressBar progress("alvio run", total, options.progress);
+
+  // An image waits until an IMU sample after it has arrived, so the estimator can
+  // interpolate the IMU at the image time.
+  std::deque<SensorMessage> pending;
+  auto processImage = [&](const SensorMessage& m) {
+    const cv::Mat image = m.load_image();
+    if (image.empty()) {
+      ++result.skipped_images;
+      logWarn("image at ", m.t_ns, " ns could not be read: skipped");
+      return;
+    }
+    PipelineOutput out = pipeline.addImage(image, m.t_ns);
+    ++result.frames;
+    result.timing.add(out.timing);
+    for (const auto& e : out.events) {
+      events_log << std::fixed << e.t << " " << eventKindName(e.kind) << " " << e.message << "\n";
+      if (e.kind == EstimatorEvent::Kind::kInitialized && gt && !result.initialization) {
+        InitializationQuality q = initializationQuality(e.window, *gt);
+        q.time = e.t;
+        q.since_motion_s = e.t - firstMotion(*gt);
+        result.initialization = q;
+      }
+    }
+    if (out.has_pose) {
+      StampedPose p;
+      p.t = out.state.t;
+      p.p = out.state.p;
+      p.q = out.state.q;
+      result.trajectory.push_back(p);
+    }
+    progress.update(result.frames + result.skipped_images,
+                    out.has_pose ? "tracking" : "initialising");
+  };
+
+  SensorMessage m;
+  std::size_t images_seen = 0;
+  while (source.next(&m)) {
+    if (m.kind == SensorMessage::Kind::kImu) {
+      pipeline.addImu(m.imu);
+      while (!pending.empty() && pending.front().t_ns < m.t_ns) {
+        processImage(pending.front());
+        pending.pop_front();
+      }
+      continue;
+    }
+    if (options.max_frames > 0 && images_seen >= static_cast<std::size_t>(options.max_frames))
+      break;
+    ++images_seen;
+    pending.push_back(m);
+  }
+  for (const auto& p : pending) processImage(p);
+  progress.finish();
+  result.resets = pipeline.estimator().resetCount();
+  result.poses = result.trajectory.size();
+
+  writeTumTrajectory((fs::path(options.out_dir) / "trajectory.tum").string(), result.trajectory);
+  writeFileAtomically((fs::path(options.out_dir) / "timing.csv").string(), result.timing.toCsv());
+  writeFileAtomically((fs::path(options.out_dir) / "events.log").string(), events_log.str());
+
+  nlohmann::json summary;
+  summary["dataset"] = source.description();
+  summary["config"] = config.source;
+  summary["frames"] = result.frames;
+  summary["poses"] = result.poses;
+  summary["skipped_images"] = result.skipped_images;
+  summary["resets"] = result.resets;
+  for (const auto& s : result.timing.summary())
+    summary["timing_ms"][s.stage] = {
+        {"median", s.median_ms}, {"p95", s.p95_ms}, {"max", s.max_ms}, {"mean", s.mean_ms}};
+  if (result.initialization) {
+    const auto& q = *result.initialization;
+    summary["initialization"] = {{"time", q.time},
+                                 {"since_first_motion_s", q.since_motion_s},
+                                 {"scale_error", q.scale_error},
+                                 {"gravity_error_deg", q.gravity_error_deg}};
+  }
+  if (gt && result.trajectory.size() >= 3) {
+    EvaluationOptions eo;
+    try {
+      result.evaluation = evaluateTrajectory(result.trajectory, *gt, eo);
+      summary["ate_rmse_m"] = result.evaluation->ate_translation_m.rmse;
+      writeFileAtomically(
+          (fs::path(options.out_dir) / "eval.json").string(),
+          evaluationToJson(*result.evaluation, eo, "dataset ground truth", "trajectory.tum"));
+    } catch (const Error& e) {
+      logWarn("evaluation failed: ", e.what());
+    }
+  }
+  writeFileAtomically((fs::path(options.out_dir) / "summary.json").string(),
+                      summary.dump(2) + "\n");
+  return result;
+}
+
+}  // namespace alvio

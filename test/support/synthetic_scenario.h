@@ -1,0 +1,52 @@
+#pragma once
+// A feature-level synthetic scenario for estimator tests that need no
+// rendering: a smooth analytic trajectory, its exact IMU (plus optional noise),
+// and point observations of landmarks on the walls of a room, with stable IDs.
+
+#include <Eigen/Core>
+#include <random>
+#include <vector>
+
+#include "alvio/common/types.h"
+#include "alvio/config/sensor_options.h"
+#include "alvio/frontend/feature_frame.h"
+
+namespace alvio::test {
+
+struct ScenarioOptions {
+  double duration_s = 20;
+  double camera_rate_hz = 20;
+  double imu_rate_hz = 200;
+  double pixel_noise = 0.5;  ///< sigma, pixels
+  bool imu_noise = true;
+  int max_points = 150;
+  unsigned seed = 1;
+};
+
+class SyntheticScenario {
+ public:
+  SyntheticScenario(const ScenarioOptions& options, const CameraOptions& camera,
+                    const ImuOptions& imu);
+
+  /// True body pose at time t (t from 0).
+  Eigen::Vector3d position(double t) const;
+  Eigen::Matrix3d rotation(double t) const;
+  Eigen::Vector3d velocity(double t) const;
+
+  const std::vector<ImuSample>& imu() const { return imu_; }
+  const std::vector<FeatureFrame>& frames() const { return frames_; }
+  Trajectory groundTruth() const;
+  static constexpr int64_t kStartNs = 1000000000000LL;  // t = 0 maps to 1000 s
+
+ private:
+  void makeImu(const ImuOptions& imu);
+  void makeFrames(const CameraOptions& camera);
+
+  ScenarioOptions options_;
+  std::mt19937 rng_;
+  std::vector<Eigen::Vector3d> landmarks_;
+  std::vector<ImuSample> imu_;
+  std::vector<FeatureFrame> frames_;
+};
+
+}  // namespace alvio::test
