@@ -141,6 +141,20 @@ void Estimator::processImu(double dt, const Eigen::Vector3d& acc, const Eigen::V
     Ps_[j] += dt * Vs_[j] + 0.5 * dt * dt * a;
     Vs_[j] += dt * a;
   }
+  if (have_output_) {
+    // Dead-reckon the last output state (output frame, midpoint rule): after a reset this
+    // carries the pose through the outage.
+    BodyState& d = dead_reckoned_;
+    const Eigen::Matrix3d R0 = d.q.toRotationMatrix();
+    const Eigen::Vector3d a0 = R0 * (acc_0_ - d.ba) + gravity_;
+    const Eigen::Matrix3d R1 =
+        R0 * expQuaternion((0.5 * (gyr_0_ + gyr) - d.bg) * dt).toRotationMatrix();
+    const Eigen::Vector3d a = 0.5 * (a0 + R1 * (acc - d.ba) + gravity_);
+    d.p += dt * d.v + 0.5 * dt * dt * a;
+    d.v += dt * a;
+    d.q = Eigen::Quaterniond(R1).normalized();
+    d.t += dt;
+  }
   acc_0_ = acc;
   gyr_0_ = gyr;
 }
@@ -215,14 +229,17 @@ bool Estimator::addFrame(const FeatureFrame& frame, FrameTiming* timing) {
     last_R_ = Rs_[W_];
     last_P_ = Ps_[W_];
   }
-  // Output continuity: after a reset, anchor the new world frame on the last output pose.
+  // Output continuity: after a reset, anchor the new world frame on the dead-reckoned pose.
   if (align_output_after_reset_) {
     align_output_after_reset_ = false;
-    out_yaw_ = yawOf(last_output_.q.toRotationMatrix()) - yawOf(Rs_[W_]);
+    out_yaw_ = yawOf(dead_reckoned_.q.toRotationMatrix()) - yawOf(Rs_[W_]);
     out_from_ = Ps_[W_];
-    out_to_ = last_output_.p;
+    out_to_ = dead_reckoned_.p;
+    logInfo("output re-anchored after ", dead_reckoned_.t - last_output_.t,
+            " s of IMU dead reckoning");
   }
   last_output_ = latestState();
+  dead_reckoned_ = last_output_;
   have_output_ = true;
   return true;
 }

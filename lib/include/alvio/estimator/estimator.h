@@ -159,9 +159,12 @@ class Estimator {
   Eigen::Vector3d last_P_ = Eigen::Vector3d::Zero(), back_P0_ = Eigen::Vector3d::Zero();
 
   // Output continuity across resets: output = yaw(out_yaw_) * (p - out_from_) + out_to_.
+  // The last output state is dead-reckoned with the IMU (in the output frame); after a
+  // reset, the re-initialised world frame is anchored on it.
   double out_yaw_ = 0;
   Eigen::Vector3d out_from_ = Eigen::Vector3d::Zero(), out_to_ = Eigen::Vector3d::Zero();
   bool have_output_ = false, align_output_after_reset_ = false;
+  BodyState dead_reckoned_;
   BodyState last_output_;
   int reset_count_ = 0;
   double init_scale_ = 0;
