@@ -366,3 +366,14 @@ TEST(LineTracker, EurocFramesAreDetectedAndTracked) {
     EXPECT_GE(continued, 0.5 * lines) << type;
   }
 }
+
+TEST(LineTrackerOptions, ShippedConfigHasTheLinesSection) {
+  const YamlReader yaml(test::sourcePath("config/euroc.yaml"));
+  const Config config = Config::load(test::sourcePath("config/euroc.yaml"));
+  EXPECT_EQ(config.lines.tracker, "flow");
+  EXPECT_EQ(config.lines.detector.max_lines, 60);
+  EXPECT_EQ(config.lines.flow.samples_per_line, 5);
+  // Every key of the section is read.
+  LineTrackerOptions::load(yaml, "lines");
+  for (const auto& key : yaml.unknownKeys()) EXPECT_NE(key.rfind("lines", 0), 0u) << key;
+}

@@ -14,6 +14,7 @@ Config Config::load(const std::string& path) {
   c.camera = CameraOptions::load(yaml, "camera");
   c.imu = ImuOptions::load(yaml, "imu");
   c.topics = TopicOptions::load(yaml, "topics");
+  c.lines = LineTrackerOptions::load(yaml, "lines");
   yaml.warnUnknownKeys();
   return c;
 }

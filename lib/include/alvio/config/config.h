@@ -5,6 +5,7 @@
 #include <string>
 
 #include "alvio/config/sensor_options.h"
+#include "alvio/lines/line_tracker_options.h"
 
 namespace alvio {
 
@@ -13,6 +14,7 @@ struct Config {
   CameraOptions camera;
   ImuOptions imu;
   TopicOptions topics;
+  LineTrackerOptions lines;
 
   /// Load and validate `path`. Missing/malformed keys throw alvio::Error naming
   /// file and key; unknown keys are logged as warnings.
