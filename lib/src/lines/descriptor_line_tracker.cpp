@@ -40,29 +40,41 @@ void DescriptorLineTracker::associate(const cv::Mat& undistorted,
   for (const cv::DMatch& m : good)
     if (prev_of[m.trainIdx] < 0) prev_of[m.trainIdx] = m.queryIdx;
 
-  std::vector<int> ids(detections.size()), counts(detections.size());
-  frame->lines.clear();
+  // Matched lines keep their ID; then new lines, as many as max_lines leaves room for.
+  std::vector<int> kept;  // detection indices, in output order
+  std::vector<int> ids, counts;
+  std::vector<bool> used(detections.size(), false);
   for (std::size_t j = 0; j < detections.size(); ++j) {
-    if (prev_of[j] >= 0) {
-      ids[j] = prev_ids_[prev_of[j]];
-      counts[j] = prev_counts_[prev_of[j]] + 1;
-      ++frame->stats.tracked;
-    } else {
-      ids[j] = newId();
-      counts[j] = 1;
-      ++frame->stats.new_lines;
-    }
-    LineObservation obs;
-    obs.id = ids[j];
-    obs.start_px = detections[j].start;
-    obs.end_px = detections[j].end;
-    obs.track_count = counts[j];
-    frame->lines.push_back(obs);
+    if (prev_of[j] < 0) continue;
+    used[j] = true;
+    kept.push_back(static_cast<int>(j));
+    ids.push_back(prev_ids_[prev_of[j]]);
+    counts.push_back(prev_counts_[prev_of[j]] + 1);
+    ++frame->stats.tracked;
   }
-  prev_segments_ = detections;
+  for (int j : selectNewLines(detections, used, static_cast<int>(kept.size()))) {
+    kept.push_back(j);
+    ids.push_back(newId());
+    counts.push_back(1);
+    ++frame->stats.new_lines;
+  }
+
+  frame->lines.clear();
+  prev_segments_.clear();
+  prev_descriptors_ = cv::Mat();
+  for (std::size_t i = 0; i < kept.size(); ++i) {
+    const LineSegment& seg = detections[kept[i]];
+    LineObservation obs;
+    obs.id = ids[i];
+    obs.start_px = seg.start;
+    obs.end_px = seg.end;
+    obs.track_count = counts[i];
+    frame->lines.push_back(obs);
+    prev_segments_.push_back(seg);
+    prev_descriptors_.push_back(descriptors.row(kept[i]));
+  }
   prev_ids_ = std::move(ids);
   prev_counts_ = std::move(counts);
-  prev_descriptors_ = descriptors;
 }
 
 }  // namespace alvio

@@ -40,13 +40,14 @@ std::vector<LineSegment> LineDetector::detect(const cv::Mat& gray, const cv::Mat
   segments.reserve(raw.size());
   for (const cv::Vec4f& r : raw) {
     const LineSegment s({r[0], r[1]}, {r[2], r[3]});
-    if (s.length() < min_length_) continue;
+    if (s.length() < shortestLength()) continue;
     if (mask && !(inside(s.start) && inside(s.end) && inside(s.midpoint()))) continue;
     segments.push_back(s);
   }
   std::sort(segments.begin(), segments.end(),
             [](const LineSegment& a, const LineSegment& b) { return a.length() > b.length(); });
-  if (static_cast<int>(segments.size()) > options_.max_lines) segments.resize(options_.max_lines);
+  if (static_cast<int>(segments.size()) > options_.max_detections)
+    segments.resize(options_.max_detections);
   return segments;
 }
 

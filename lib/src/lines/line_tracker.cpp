@@ -39,7 +39,8 @@ LineFrame LineTracker::trackUndistorted(const cv::Mat& undistorted, double t) {
   const std::vector<LineSegment> detections =
       detector_.detect(undistorted, undistorter_.validMask());
   frame.stats.detect_ms = msSince(start);
-  frame.stats.detected = static_cast<int>(detections.size());
+  for (const LineSegment& s : detections)
+    frame.stats.detected += s.length() >= detector_.minLength();
 
   start = std::chrono::steady_clock::now();
   associate(undistorted, detections, &frame);
@@ -49,6 +50,16 @@ LineFrame LineTracker::trackUndistorted(const cv::Mat& undistorted, double t) {
   }
   frame.stats.track_ms = msSince(start);
   return frame;
+}
+
+std::vector<int> LineTracker::selectNewLines(const std::vector<LineSegment>& detections,
+                                             const std::vector<bool>& used, int tracked) const {
+  std::vector<int> selected;
+  const int room = options_.detector.max_lines - tracked;
+  for (std::size_t j = 0; j < detections.size() && static_cast<int>(selected.size()) < room; ++j)
+    if (!used[j] && detections[j].length() >= detector_.minLength())
+      selected.push_back(static_cast<int>(j));  // detections come longest first
+  return selected;
 }
 
 std::unique_ptr<LineTracker> createLineTracker(const CameraOptions& camera,

@@ -29,7 +29,10 @@ LineDetectorOptions LineDetectorOptions::load(const YamlReader& yaml, const std:
   LineDetectorOptions o;
   const std::string p = keyPrefix(prefix);
   o.min_length_ratio = yaml.getDouble(p + "min_length_ratio", o.min_length_ratio);
+  o.continuation_length_factor =
+      yaml.getDouble(p + "continuation_length_factor", o.continuation_length_factor);
   o.max_lines = yaml.getInt(p + "max_lines", o.max_lines);
+  o.max_detections = yaml.getInt(p + "max_detections", o.max_detections);
   o.lsd_scale = yaml.getDouble(p + "lsd_scale", o.lsd_scale);
   o.lsd_sigma_scale = yaml.getDouble(p + "lsd_sigma_scale", o.lsd_sigma_scale);
   o.lsd_refine = yaml.getBool(p + "lsd_refine", o.lsd_refine);
@@ -41,7 +44,10 @@ LineDetectorOptions LineDetectorOptions::load(const YamlReader& yaml, const std:
 void LineDetectorOptions::validate(const std::string& where) const {
   require(min_length_ratio > 0 && min_length_ratio < 1, where, "min_length_ratio", "in (0, 1)",
           min_length_ratio);
+  require(continuation_length_factor > 0 && continuation_length_factor <= 1, where,
+          "continuation_length_factor", "in (0, 1]", continuation_length_factor);
   require(max_lines > 0, where, "max_lines", "positive", max_lines);
+  require(max_detections >= max_lines, where, "max_detections", ">= max_lines", max_detections);
   require(lsd_scale > 0 && lsd_scale <= 1, where, "lsd_scale", "in (0, 1]", lsd_scale);
   require(lsd_sigma_scale > 0, where, "lsd_sigma_scale", "positive", lsd_sigma_scale);
   require(border_margin_px >= 0, where, "border_margin_px", "non-negative", border_margin_px);

@@ -229,8 +229,7 @@ void OpticalFlowLineTracker::associate(const cv::Mat& undistorted,
     frame->stats.merged += merged;
     frame->stats.clipped += predictions_[i].clipped;
   }
-  for (std::size_t j = 0; j < detections.size(); ++j) {
-    if (used[j]) continue;
+  for (int j : selectNewLines(detections, used, static_cast<int>(next.size()))) {
     next.push_back({newId(), detections[j], 1});
     ++frame->stats.new_lines;
   }

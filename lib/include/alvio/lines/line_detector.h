@@ -1,6 +1,7 @@
 #pragma once
 // LSD line segment detection (OpenCV's cv::LineSegmentDetector), with a minimum length and a
-// cap on the count. The detector is built once and reused for every frame.
+// cap on the count (the longest are kept). The detector is built once and reused for every
+// frame.
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
@@ -15,13 +16,16 @@ class LineDetector {
  public:
   LineDetector(const LineDetectorOptions& options, cv::Size image_size);
 
-  /// Segments at least minLength() long, the longest maxLines() of them, longest first.
-  /// With a `valid_mask` (CV_8U, non-zero = valid), segments whose endpoints or midpoint are
-  /// within the border margin of an invalid pixel are dropped.
+  /// Segments at least shortestLength() long, the longest max_detections of them, longest
+  /// first. With a `valid_mask` (CV_8U, non-zero = valid), segments whose endpoints or midpoint
+  /// are within the border margin of an invalid pixel are dropped.
   std::vector<LineSegment> detect(const cv::Mat& gray, const cv::Mat& valid_mask = cv::Mat());
 
+  /// Minimum length of a new line [px].
   double minLength() const { return min_length_; }
-  int maxLines() const { return options_.max_lines; }
+  /// Minimum length of any returned segment (continuations, pieces of split lines) [px].
+  double shortestLength() const { return min_length_ * options_.continuation_length_factor; }
+  const LineDetectorOptions& options() const { return options_; }
 
  private:
   LineDetectorOptions options_;

@@ -5,8 +5,10 @@
 //
 // Every tracker undistorts the raw image to the camera's pinhole image (ImageUndistorter),
 // detects LSD segments there (LineDetector) and associates them with the previous frame's
-// lines. Pixel coordinates in the output are in that pinhole image; normalised ones are
-// K^-1 of them, i.e. undistorted normalised coordinates, as the estimator needs.
+// lines. Tracked lines may continue with segments shorter than a new line must be
+// (hysteresis), and take precedence over new lines under the max_lines cap. Pixel coordinates in
+// the output are in that pinhole image; normalised ones are K^-1 of them, i.e. undistorted
+// normalised coordinates, as the estimator needs.
 
 #include <Eigen/Core>
 #include <memory>
@@ -70,6 +72,10 @@ class LineTracker {
   virtual void associate(const cv::Mat& undistorted, const std::vector<LineSegment>& detections,
                          LineFrame* frame) = 0;
   int newId() { return next_id_++; }
+  /// The unused detections that start new lines this frame: long enough for a new line,
+  /// longest first, no more than leave room under max_lines after `tracked` lines.
+  std::vector<int> selectNewLines(const std::vector<LineSegment>& detections,
+                                  const std::vector<bool>& used, int tracked) const;
 
   LineTrackerOptions options_;
 

@@ -16,10 +16,16 @@ namespace alvio {
 class YamlReader;
 
 struct LineDetectorOptions {
-  /// Minimum segment length as a fraction of the image diagonal (0.06 * 892 px = 54 px).
+  /// Minimum length of a new line as a fraction of the image diagonal (0.06 * 892 px = 54 px).
   double min_length_ratio = 0.06;
-  /// Keep at most this many segments per frame, the longest ones.
+  /// A tracked line may continue with (and a split line be merged from) segments down to this
+  /// fraction of the minimum length: hysteresis, so that a line near the threshold does not
+  /// flicker in and out.
+  double continuation_length_factor = 0.5;
+  /// At most this many lines per frame: the tracked ones first, then new ones, longest first.
   int max_lines = 60;
+  /// The detector keeps at most this many segments (the longest), to bound the association.
+  int max_detections = 150;
   /// LSD works on the image scaled by this factor (OpenCV's `scale`); 0.5 halves the
   /// detection time on EuRoC at a small loss of short segments.
   double lsd_scale = 0.5;
@@ -38,7 +44,7 @@ struct LineDetectorOptions {
 struct FlowLineTrackerOptions {
   /// Points tracked per line with KLT: both endpoints and (n - 2) evenly spaced interior ones.
   int samples_per_line = 5;
-  int klt_window_px = 21;
+  int klt_window_px = 15;
   int klt_pyramid_levels = 3;
   int klt_max_iterations = 30;
   double klt_epsilon = 0.01;
