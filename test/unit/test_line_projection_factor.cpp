@@ -61,8 +61,8 @@ TEST(LineProjectionFactor, ZeroResidualForEndpointsOnTheProjectedLine) {
 }
 
 TEST(LineProjectionFactor, ResidualIsSignedDistanceScaledBySqrtInfo) {
-  // Camera = body = world; the line y = 0.5 z in the plane x... : a horizontal line through
-  // (0, 0.5, 1) along x projects to the image line v = 0.5.
+  // Camera = body = world: the line through (0, 0.5, 1) along x projects to the image line
+  // v = 0.5 (normalised coordinates).
   const PluckerLine line_w = PluckerLine::fromPoints({0, 0.5, 1}, {1, 0.5, 1});
   double pose[7], line[4];
   poseToParameters(Eigen::Isometry3d::Identity(), pose);

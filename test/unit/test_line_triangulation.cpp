@@ -5,6 +5,8 @@
 #include <cmath>
 #include <numeric>
 
+#include "alvio/common/error.h"
+#include "alvio/config/yaml_reader.h"
 #include "alvio/geometry/line_landmark.h"
 #include "alvio/geometry/line_projection_factor.h"
 #include "alvio/geometry/line_triangulation.h"
@@ -213,4 +215,21 @@ TEST(LineLandmark, ExtentGrowsAndFollowsTheLine) {
   EXPECT_NEAR(lm.start_w.z(), 1.1, 1e-12);
   EXPECT_NEAR(lm.end_w.x(), 0.5, 1e-12);
   EXPECT_STREQ(toString(lm.status), "optimised");
+}
+
+TEST(LineTriangulationOptions, LoadFromYamlAndNameBadKeys) {
+  const auto yaml = YamlReader::fromString(
+      "lines:\n  triangulation: {min_plane_angle_deg: 2.5, refine_huber_scale: 0.01}\n", "t.yaml");
+  const auto o = LineTriangulationOptions::load(yaml, "lines.triangulation");
+  EXPECT_DOUBLE_EQ(o.min_plane_angle_deg, 2.5);
+  EXPECT_DOUBLE_EQ(o.refine_huber_scale, 0.01);
+  EXPECT_DOUBLE_EQ(o.min_depth, LineTriangulationOptions().min_depth);
+  const auto bad = YamlReader::fromString("tri: {min_baseline: -1}\n", "bad.yaml");
+  try {
+    LineTriangulationOptions::load(bad, "tri");
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("bad.yaml"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("tri.min_baseline"), std::string::npos) << e.what();
+  }
 }

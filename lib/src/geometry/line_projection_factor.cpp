@@ -51,7 +51,8 @@ bool LineProjectionFactor::Evaluate(double const* const* parameters, double* res
   // Not normalised: the ambient Jacobian below is of exactly this formula.
   const Eigen::Matrix3d R_w_b = q_w_b.toRotationMatrix();
 
-  const PluckerLine L_w = pluckerFromParameters(x_line);
+  const OrthonormalLine ortho_w = OrthonormalLine::fromParameters(x_line);
+  const PluckerLine L_w = ortho_w.toPlucker();
   // World -> body: moment about the body origin, then rotate. Body -> camera likewise.
   const Eigen::Vector3d m_w = L_w.n - t_w_b.cross(L_w.d);
   const Eigen::Vector3d n_b = R_w_b.transpose() * m_w;
@@ -94,7 +95,7 @@ bool LineProjectionFactor::Evaluate(double const* const* parameters, double* res
     dl_dnd.rightCols<3>() = -A * R_w_b.transpose() * skew(t_w_b) + B * R_w_b.transpose();
     // Tangent Jacobian, then to the ambient [theta, phi]: d(tangent)/d(theta) = Jr(theta).
     const Eigen::Matrix<double, 2, 4> J_tangent =
-        dr_dl * dl_dnd * pluckerJacobianWrtTangent(x_line);
+        dr_dl * dl_dnd * pluckerJacobianWrtTangent(ortho_w);
     J.leftCols<3>() = J_tangent.leftCols<3>() *
                       rightJacobianSO3(Eigen::Vector3d(x_line[0], x_line[1], x_line[2]));
     J.col(3) = J_tangent.col(3);

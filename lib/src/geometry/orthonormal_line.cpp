@@ -54,11 +54,14 @@ PluckerLine pluckerFromParameters(const double* x) {
 }
 
 Eigen::Matrix<double, 6, 4> pluckerJacobianWrtTangent(const double* x) {
+  return pluckerJacobianWrtTangent(OrthonormalLine::fromParameters(x));
+}
+
+Eigen::Matrix<double, 6, 4> pluckerJacobianWrtTangent(const OrthonormalLine& line) {
   // U Exp(dtheta) ~= U (I + [dtheta]x): du1 = dtheta3 u2 - dtheta2 u3,
   // du2 = -dtheta3 u1 + dtheta1 u3; and (w1, w2) rotates: dw1 = -w2 dphi, dw2 = w1 dphi.
-  const Eigen::Matrix3d U = expSO3(Eigen::Vector3d(x[0], x[1], x[2]));
-  const double w1 = std::cos(x[3]), w2 = std::sin(x[3]);
-  const Eigen::Vector3d u1 = U.col(0), u2 = U.col(1), u3 = U.col(2);
+  const double w1 = std::cos(line.phi), w2 = std::sin(line.phi);
+  const Eigen::Vector3d u1 = line.U.col(0), u2 = line.U.col(1), u3 = line.U.col(2);
   Eigen::Matrix<double, 6, 4> J;
   J.block<3, 1>(0, 0).setZero();
   J.block<3, 1>(0, 1) = -w1 * u3;

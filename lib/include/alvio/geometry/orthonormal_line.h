@@ -41,5 +41,7 @@ PluckerLine pluckerFromParameters(const double* x);
 /// d(n, d) / d(tangent) at the parameter block, a 6x4 matrix (rows n then d), for the
 /// tangent update U <- U Exp(dtheta), phi <- phi + dphi (OrthonormalLineManifold::Plus).
 Eigen::Matrix<double, 6, 4> pluckerJacobianWrtTangent(const double* x);
+/// Same, from U and phi already at hand.
+Eigen::Matrix<double, 6, 4> pluckerJacobianWrtTangent(const OrthonormalLine& line);
 
 }  // namespace alvio
