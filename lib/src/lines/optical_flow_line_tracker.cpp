@@ -63,6 +63,7 @@ bool OpticalFlowLineTracker::predictOne(const Track& track, const std::vector<cv
   const int n = options_.flow.samples_per_line;
   const double length = track.segment.length();
   std::vector<double> along_prev;
+  std::vector<int> sample;  // index k of each kept point: 0 and n - 1 are the endpoints
   std::vector<Eigen::Vector2d> points;
   // Samples within half a KLT window of the border are tracked with a truncated window and
   // drift; an endpoint that the border cut off is not a point of the scene either.
@@ -76,6 +77,7 @@ bool OpticalFlowLineTracker::predictOne(const Track& track, const std::vector<cv
         before.y() > image_size.height - 1 - margin)
       continue;
     along_prev.push_back(length * k / (n - 1));
+    sample.push_back(k);
     points.emplace_back(p.x, p.y);
   }
   const Eigen::Vector2d reference = track.segment.end - track.segment.start;
@@ -87,10 +89,12 @@ bool OpticalFlowLineTracker::predictOne(const Track& track, const std::vector<cv
     if (!inlier[i]) continue;
     points[kept] = points[i];
     along_prev[kept] = along_prev[i];
+    sample[kept] = sample[i];
     ++kept;
   }
   points.resize(kept);
   along_prev.resize(kept);
+  sample.resize(kept);
   // Positions along the new line as a function s = a t + b of the old ones. Interior samples
   // sit on a plain edge, where KLT only sees the motion across the edge (aperture problem), so
   // the extent comes from the endpoints: both -> a and b; one -> a shift (a = 1); none -> the
@@ -100,8 +104,8 @@ bool OpticalFlowLineTracker::predictOne(const Track& track, const std::vector<cv
   for (std::size_t i = 0; i < m; ++i) along_cur[i] = fit.positionAlong(points[i]);
   int i_start = -1, i_end = -1;
   for (std::size_t i = 0; i < m; ++i) {
-    if (along_prev[i] == 0.0) i_start = static_cast<int>(i);
-    if (along_prev[i] == length) i_end = static_cast<int>(i);
+    if (sample[i] == 0) i_start = static_cast<int>(i);
+    if (sample[i] == n - 1) i_end = static_cast<int>(i);
   }
   double a = 1.0, b = 0.0;
   if (i_start >= 0 && i_end >= 0) {
