@@ -7,6 +7,7 @@
 #include "alvio/config/sensor_options.h"
 #include "alvio/estimator/estimator_options.h"
 #include "alvio/frontend/point_tracker.h"
+#include "alvio/lines/line_tracker_options.h"
 
 namespace alvio {
 
@@ -17,6 +18,7 @@ struct Config {
   TopicOptions topics;
   PointTrackerOptions points;
   EstimatorOptions estimator;
+  LineTrackerOptions lines;
 
   /// Load and validate `path`. Missing/malformed keys throw alvio::Error naming
   /// file and key; unknown keys are logged as warnings.

@@ -1,0 +1,92 @@
+#pragma once
+// The line front end's interface: one grey image in, the frame's line observations with
+// persistent track IDs out. Implementations: OpticalFlowLineTracker (ALVIO) and
+// DescriptorLineTracker (PL-VIO-style baseline).
+//
+// Every tracker undistorts the raw image to the camera's pinhole image (ImageUndistorter),
+// detects LSD segments there (LineDetector) and associates them with the previous frame's
+// lines. Tracked lines may continue with segments shorter than a new line must be
+// (hysteresis), and take precedence over new lines under the max_lines cap. Pixel coordinates in
+// the output are in that pinhole image; normalised ones are K^-1 of them, i.e. undistorted
+// normalised coordinates, as the estimator needs.
+
+#include <Eigen/Core>
+#include <memory>
+#include <opencv2/core.hpp>
+#include <vector>
+
+#include "alvio/config/sensor_options.h"
+#include "alvio/lines/image_undistorter.h"
+#include "alvio/lines/line_detector.h"
+#include "alvio/lines/line_segment.h"
+#include "alvio/lines/line_tracker_options.h"
+
+namespace alvio {
+
+struct LineObservation {
+  int id = -1;                                         ///< track ID, kept while the line is tracked
+  Eigen::Vector2d start_px = Eigen::Vector2d::Zero();  ///< in the undistorted pinhole image
+  Eigen::Vector2d end_px = Eigen::Vector2d::Zero();
+  Eigen::Vector2d start_norm = Eigen::Vector2d::Zero();  ///< undistorted normalised
+  Eigen::Vector2d end_norm = Eigen::Vector2d::Zero();
+  int track_count = 1;  ///< frames this ID has been observed in, this one included
+  EIGEN_MAKE_ALIGNED_OPERATOR_NEW
+};
+
+struct LineTrackStats {
+  int detected = 0;   ///< LSD segments kept by the detector
+  int tracked = 0;    ///< observations continuing a previous ID (types 1, 3 and 4)
+  int new_lines = 0;  ///< observations with a new ID (type 2)
+  int merged = 0;     ///< tracked lines merged from two or more detections (type 3)
+  int clipped = 0;    ///< tracked lines whose prediction was clipped at the border (type 4)
+  double undistort_ms = 0.0;
+  double detect_ms = 0.0;
+  double track_ms = 0.0;  ///< association (optical flow or descriptors, matching)
+};
+
+struct LineFrame {
+  double t = 0.0;
+  std::vector<LineObservation, Eigen::aligned_allocator<LineObservation>> lines;
+  LineTrackStats stats;
+};
+
+class LineTracker {
+ public:
+  LineTracker(const CameraOptions& camera, const LineTrackerOptions& options);
+  virtual ~LineTracker() = default;
+  LineTracker(const LineTracker&) = delete;
+  LineTracker& operator=(const LineTracker&) = delete;
+
+  /// Process one raw (distorted) 8-bit grey image taken at time t [s].
+  LineFrame track(const cv::Mat& gray, double t);
+  /// Same, for an image already undistorted with undistorter() (to share the remap).
+  LineFrame trackUndistorted(const cv::Mat& undistorted, double t);
+
+  const ImageUndistorter& undistorter() const { return undistorter_; }
+  const LineTrackerOptions& options() const { return options_; }
+  virtual const char* name() const = 0;
+
+ protected:
+  /// Associate this frame's detections with the previous frame's lines: fill `frame.lines`
+  /// (pixel coordinates, id, track_count) and the association counters of `frame.stats`.
+  virtual void associate(const cv::Mat& undistorted, const std::vector<LineSegment>& detections,
+                         LineFrame* frame) = 0;
+  int newId() { return next_id_++; }
+  /// The unused detections that start new lines this frame: long enough for a new line,
+  /// longest first, no more than leave room under max_lines after `tracked` lines.
+  std::vector<int> selectNewLines(const std::vector<LineSegment>& detections,
+                                  const std::vector<bool>& used, int tracked) const;
+
+  LineTrackerOptions options_;
+
+ private:
+  ImageUndistorter undistorter_;
+  LineDetector detector_;
+  int next_id_ = 0;
+};
+
+/// The tracker named by options.tracker ("flow" or "descriptor").
+std::unique_ptr<LineTracker> createLineTracker(const CameraOptions& camera,
+                                               const LineTrackerOptions& options);
+
+}  // namespace alvio

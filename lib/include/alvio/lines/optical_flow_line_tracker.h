@@ -1,0 +1,61 @@
+#pragma once
+// ALVIO's optical-flow line tracker (Jung et al., section 2.2).
+//
+// Per frame:
+//  1. Predict: every previous line is sampled at samples_per_line points (both endpoints and
+//     interior points) that pyramidal KLT moves into the current frame. A line is fitted to the
+//     moved points (consensus over point pairs, then least squares on the agreeing ones); the
+//     extent along it comes from the moved endpoints (interior points of a plain edge do not
+//     see motion along the edge), and from the one left if the other was lost, keeping the
+//     length. A prediction leaving the image is clipped to the border along its own slope
+//     (type 4).
+//  2. Match: for each prediction the K nearest detections (by perpendicular distance and angle)
+//     that are parallel, close to its line and overlap it are candidates; each detection goes to
+//     its best prediction.
+//  3. Merge and filter: two or more detections of one prediction are merged into one segment
+//     (type 3). The result must pass the length-ratio and centre-distance filters, else the best
+//     single detection is tried. Matched lines keep their ID (types 1, 3, 4); the remaining
+//     detections get new IDs (type 2).
+
+#include <opencv2/core.hpp>
+#include <vector>
+
+#include "alvio/lines/line_tracker.h"
+
+namespace alvio {
+
+class OpticalFlowLineTracker final : public LineTracker {
+ public:
+  OpticalFlowLineTracker(const CameraOptions& camera, const LineTrackerOptions& options);
+  const char* name() const override { return "flow"; }
+
+  /// A previous line predicted into the current frame.
+  struct Prediction {
+    LineSegment segment;
+    bool valid = false;    ///< enough points were tracked and something is left in the image
+    bool clipped = false;  ///< an endpoint was predicted outside the image (type 4)
+  };
+  /// The predictions made in the last call (one per previous line), for inspection and tests.
+  const std::vector<Prediction>& lastPredictions() const { return predictions_; }
+
+ protected:
+  void associate(const cv::Mat& undistorted, const std::vector<LineSegment>& detections,
+                 LineFrame* frame) override;
+
+ private:
+  struct Track {
+    int id;
+    LineSegment segment;
+    int count;
+  };
+  void predict(const std::vector<cv::Mat>& pyramid, cv::Size image_size);
+  bool predictOne(const Track& track, const std::vector<cv::Point2f>& moved,
+                  const std::vector<uchar>& status, std::size_t first, cv::Size image_size,
+                  Prediction* prediction) const;
+
+  std::vector<Track> tracks_;
+  std::vector<cv::Mat> prev_pyramid_;
+  std::vector<Prediction> predictions_;
+};
+
+}  // namespace alvio

@@ -1,0 +1,54 @@
+#include "alvio/lines/line_detector.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace alvio {
+
+LineDetector::LineDetector(const LineDetectorOptions& options, cv::Size image_size)
+    : options_(options) {
+  options_.validate("line detector");
+  min_length_ = options_.min_length_ratio * std::hypot(image_size.width, image_size.height);
+  // OpenCV's defaults apart from the scale, sigma and refinement (quant 2, angle 22.5 deg,
+  // log_eps 0, density 0.7, 1024 bins).
+  lsd_ =
+      cv::createLineSegmentDetector(options_.lsd_refine ? cv::LSD_REFINE_STD : cv::LSD_REFINE_NONE,
+                                    options_.lsd_scale, options_.lsd_sigma_scale);
+}
+
+std::vector<LineSegment> LineDetector::detect(const cv::Mat& gray, const cv::Mat& valid_mask) {
+  std::vector<cv::Vec4f> raw;
+  lsd_->detect(gray, raw);
+
+  // The mask is the undistorter's, the same every frame: prepare it once.
+  if (valid_mask.data != source_mask_.data) {
+    source_mask_ = valid_mask;
+    eroded_mask_.release();
+    if (!valid_mask.empty() &&
+        cv::countNonZero(valid_mask) < static_cast<int>(valid_mask.total())) {
+      const int k = 2 * options_.border_margin_px + 1;
+      cv::erode(valid_mask, eroded_mask_, cv::getStructuringElement(cv::MORPH_RECT, {k, k}));
+    }
+  }
+  const cv::Mat* mask = eroded_mask_.empty() ? nullptr : &eroded_mask_;
+  auto inside = [&](const Eigen::Vector2d& p) {
+    const int u = static_cast<int>(std::lround(p.x())), v = static_cast<int>(std::lround(p.y()));
+    return u >= 0 && v >= 0 && u < mask->cols && v < mask->rows && mask->at<uint8_t>(v, u) != 0;
+  };
+
+  std::vector<LineSegment> segments;
+  segments.reserve(raw.size());
+  for (const cv::Vec4f& r : raw) {
+    const LineSegment s({r[0], r[1]}, {r[2], r[3]});
+    if (s.length() < shortestLength()) continue;
+    if (mask && !(inside(s.start) && inside(s.end) && inside(s.midpoint()))) continue;
+    segments.push_back(s);
+  }
+  std::sort(segments.begin(), segments.end(),
+            [](const LineSegment& a, const LineSegment& b) { return a.length() > b.length(); });
+  if (static_cast<int>(segments.size()) > options_.max_detections)
+    segments.resize(options_.max_detections);
+  return segments;
+}
+
+}  // namespace alvio

@@ -1,0 +1,404 @@
+// Line front end: detection, the optical-flow tracker's four track types on synthetic images,
+// the descriptor baseline, undistortion and the options.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <opencv2/imgcodecs.hpp>
+#include <set>
+
+#include "alvio/camera/camera_model.h"
+#include "alvio/common/error.h"
+#include "alvio/config/config.h"
+#include "alvio/config/yaml_reader.h"
+#include "alvio/lines/descriptor_line_tracker.h"
+#include "alvio/lines/line_detector.h"
+#include "alvio/lines/optical_flow_line_tracker.h"
+#include "synthetic_line_scene.h"
+#include "test_support.h"
+
+using namespace alvio;
+using test::Bar;
+using test::Occluder;
+
+namespace {
+constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
+const cv::Size kSize(752, 480);
+
+LineSegment segmentOf(const LineObservation& o) {
+  return {o.start_px, o.end_px};
+}
+
+// The two long edges of a bar (directions unspecified).
+std::vector<LineSegment> longEdges(const Bar& bar, cv::Point2d offset) {
+  const double a = bar.angle_deg / kRadToDeg;
+  const Eigen::Vector2d u(std::cos(a), std::sin(a)), n(-std::sin(a), std::cos(a));
+  const Eigen::Vector2d c(bar.centre.x + offset.x, bar.centre.y + offset.y);
+  const double hl = bar.size.width / 2, ht = bar.size.height / 2;
+  return {{c - hl * u + ht * n, c + hl * u + ht * n}, {c - hl * u - ht * n, c + hl * u - ht * n}};
+}
+
+// Does the observation lie on the edge's line (both endpoints within tol px, parallel)?
+bool onLine(const LineObservation& o, const LineSegment& edge, double tol_px = 1.5) {
+  return edge.distanceToLine(o.start_px) < tol_px && edge.distanceToLine(o.end_px) < tol_px;
+}
+
+std::map<int, LineObservation> byId(const LineFrame& f) {
+  std::map<int, LineObservation> m;
+  for (const auto& o : f.lines) EXPECT_TRUE(m.emplace(o.id, o).second) << "duplicate id " << o.id;
+  return m;
+}
+
+LineTrackerOptions defaultOptions() {
+  return LineTrackerOptions();
+}
+
+// A scene with bars of several orientations, all edges >= the minimum length (54 px).
+const std::vector<Bar> kBars = {
+    {{200, 150}, {220, 40}, 0},
+    {{520, 140}, {180, 36}, 60},
+    {{250, 350}, {260, 44}, -20},
+    {{560, 360}, {140, 70}, 10},
+};
+}  // namespace
+
+TEST(LineDetector, KeepsLongSegmentsLongestFirstUpToTheCap) {
+  const test::SyntheticLineScene scene(kSize);
+  const cv::Mat image = scene.render(kBars, {0, 0});
+  LineDetectorOptions o;
+  LineDetector detector(o, kSize);
+  EXPECT_NEAR(detector.minLength(), 0.06 * std::hypot(752, 480), 1e-9);
+  EXPECT_NEAR(detector.shortestLength(), 0.5 * detector.minLength(), 1e-9);
+  const auto lines = detector.detect(image);
+  // 2 long edges per bar + the 2 short (70 px) edges of the last one are new-line material.
+  int long_enough = 0;
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    EXPECT_GE(lines[i].length(), detector.shortestLength());
+    long_enough += lines[i].length() >= detector.minLength();
+    if (i > 0) {
+      EXPECT_LE(lines[i].length(), lines[i - 1].length());
+    }
+  }
+  EXPECT_GE(long_enough, 10);
+  EXPECT_LE(long_enough, 14);
+  o.max_lines = o.max_detections = 4;
+  const auto capped = LineDetector(o, kSize).detect(image);
+  ASSERT_EQ(capped.size(), 4u);
+  for (std::size_t i = 0; i < 4; ++i) EXPECT_NEAR(capped[i].length(), lines[i].length(), 1e-9);
+}
+
+TEST(LineTracker, TrackedLinesComeFirstUnderTheCap) {
+  // With room for 6 lines, the second frame keeps the 6 tracked ones and starts none of the
+  // new bar's longer edges.
+  const test::SyntheticLineScene scene(kSize);
+  LineTrackerOptions options;
+  options.detector.max_lines = 6;
+  for (const std::string type : {"flow", "descriptor"}) {
+    options.tracker = type;
+    const auto tracker = createLineTracker(test::undistortedCamera(), options);
+    const LineFrame f1 = tracker->track(scene.render(kBars, {0, 0}), 0.0);
+    ASSERT_EQ(f1.lines.size(), 6u) << type;
+    std::vector<Bar> more = kBars;
+    more.push_back({{680, 200}, {300, 40}, 90});  // longer than any other edge
+    const LineFrame f2 = tracker->track(scene.render(more, {3, 2}), 0.05);
+    EXPECT_EQ(f2.lines.size(), 6u) << type;
+    EXPECT_EQ(f2.stats.tracked, 6) << type;
+    EXPECT_EQ(f2.stats.new_lines, 0) << type;
+  }
+}
+
+TEST(OpticalFlowLineTracker, Type1KeptLinesKeepTheirIds) {
+  const test::SyntheticLineScene scene(kSize);
+  OpticalFlowLineTracker tracker(test::undistortedCamera(), defaultOptions());
+  const LineFrame f1 = tracker.track(scene.render(kBars, {0, 0}), 0.0);
+  ASSERT_GE(f1.lines.size(), 10u);
+  EXPECT_EQ(f1.stats.new_lines, static_cast<int>(f1.lines.size()));
+  const cv::Point2d offsets[] = {{7.3, -4.6}, {13.9, -8.1}, {18.2, -14.7}};
+  auto previous = byId(f1);
+  for (int k = 0; k < 3; ++k) {
+    const LineFrame f = tracker.track(scene.render(kBars, offsets[k]), 0.05 * (k + 1));
+    EXPECT_EQ(f.stats.new_lines, 0) << "frame " << k + 2;
+    EXPECT_EQ(f.stats.tracked, static_cast<int>(f1.lines.size())) << "frame " << k + 2;
+    EXPECT_EQ(f.stats.merged, 0);
+    EXPECT_EQ(f.stats.clipped, 0);
+    const cv::Point2d step = offsets[k] - (k ? offsets[k - 1] : cv::Point2d(0, 0));
+    for (const auto& [id, obs] : byId(f)) {
+      ASSERT_TRUE(previous.count(id)) << "unknown id " << id;
+      EXPECT_EQ(obs.track_count, k + 2);
+      // The same edge: the previous observation moved by the scene's step is on this line.
+      const LineObservation& before = previous.at(id);
+      const Eigen::Vector2d d(step.x, step.y);
+      const LineSegment moved(before.start_px + d, before.end_px + d);
+      EXPECT_LT(segmentOf(obs).distanceToLine(moved.start), 1.5);
+      EXPECT_LT(segmentOf(obs).distanceToLine(moved.end), 1.5);
+      EXPECT_LT(angleDifference(segmentOf(obs).angle(), moved.angle()) * kRadToDeg, 2.0);
+    }
+    previous = byId(f);
+  }
+}
+
+TEST(OpticalFlowLineTracker, Type2NewLinesGetNewIds) {
+  const test::SyntheticLineScene scene(kSize);
+  OpticalFlowLineTracker tracker(test::undistortedCamera(), defaultOptions());
+  const auto f1 = byId(tracker.track(scene.render(kBars, {0, 0}), 0.0));
+  std::vector<Bar> more = kBars;
+  const Bar added{{680, 200}, {200, 40}, 90};  // clear of the other bars
+  more.push_back(added);
+  const cv::Point2d offset(-5.5, 3.0);
+  const LineFrame f2 = tracker.track(scene.render(more, offset), 0.05);
+  EXPECT_EQ(f2.stats.new_lines, 2);
+  EXPECT_EQ(f2.stats.tracked, static_cast<int>(f1.size()));
+  int new_on_added = 0;
+  for (const auto& obs : f2.lines) {
+    if (f1.count(obs.id)) {
+      EXPECT_EQ(obs.track_count, 2);
+      continue;
+    }
+    EXPECT_EQ(obs.track_count, 1);
+    const auto edges = longEdges(added, offset);
+    new_on_added += onLine(obs, edges[0]) || onLine(obs, edges[1]);
+  }
+  EXPECT_EQ(new_on_added, 2);
+}
+
+TEST(OpticalFlowLineTracker, Type3SplitLineIsMergedUnderItsOldId) {
+  const test::SyntheticLineScene scene(kSize);
+  const std::vector<Bar> bar = {{{376, 240}, {500, 40}, 0}};
+  OpticalFlowLineTracker tracker(test::undistortedCamera(), defaultOptions());
+  const LineFrame f1 = tracker.track(scene.render(bar, {0, 0}), 0.0);
+  ASSERT_EQ(f1.lines.size(), 2u);
+
+  // Next frame: moved, and a 60 px square of background hides the bar's middle, so LSD finds
+  // each long edge as two pieces of ~220 px.
+  const cv::Point2d offset(5, 3);
+  const cv::Mat split = scene.render(bar, offset, {Occluder{{376, 240}, 30}});
+  LineDetector detector(LineDetectorOptions(), kSize);
+  int pieces = 0;
+  for (const auto& seg : detector.detect(split)) pieces += seg.length() >= detector.minLength();
+  ASSERT_EQ(pieces, 4);
+
+  const LineFrame f2 = tracker.track(split, 0.05);
+  EXPECT_EQ(f2.stats.detected, 4);
+  EXPECT_EQ(f2.stats.merged, 2);
+  EXPECT_EQ(f2.stats.new_lines, 0);
+  ASSERT_EQ(f2.lines.size(), 2u);
+  const auto before = byId(f1);
+  const auto edges = longEdges(bar[0], offset);
+  for (const auto& obs : f2.lines) {
+    ASSERT_TRUE(before.count(obs.id));
+    EXPECT_TRUE(onLine(obs, edges[0]) || onLine(obs, edges[1]));
+    // The merged segment spans both pieces: the whole edge as detected in the first frame,
+    // moved by the offset (and oriented the same way).
+    const LineObservation& whole = before.at(obs.id);
+    EXPECT_NEAR(obs.start_px.x(), whole.start_px.x() + offset.x, 3.0);
+    EXPECT_NEAR(obs.end_px.x(), whole.end_px.x() + offset.x, 3.0);
+  }
+}
+
+TEST(OpticalFlowLineTracker, Type4LineLeavingTheImageKeepsItsId) {
+  const test::SyntheticLineScene scene(kSize);
+  const std::vector<Bar> bar = {{{560, 240}, {300, 40}, 0}};  // x from 410 to 710
+  OpticalFlowLineTracker tracker(test::undistortedCamera(), defaultOptions());
+  const LineFrame f1 = tracker.track(scene.render(bar, {0, 0}), 0.0);
+  ASSERT_EQ(f1.lines.size(), 2u);
+  const auto first = byId(f1);
+  // Move right 25 px a frame: the right ends leave the image from the second step on.
+  int clipped = 0;
+  for (int k = 1; k <= 4; ++k) {
+    const cv::Point2d offset(25.0 * k, 2.0 * k);
+    const LineFrame f = tracker.track(scene.render(bar, offset), 0.05 * k);
+    clipped += f.stats.clipped;
+    EXPECT_EQ(f.stats.new_lines, 0) << "frame " << k;
+    ASSERT_EQ(f.lines.size(), 2u) << "frame " << k;
+    const auto edges = longEdges(bar[0], offset);
+    for (const auto& obs : f.lines) {
+      EXPECT_TRUE(first.count(obs.id)) << "frame " << k;
+      EXPECT_EQ(obs.track_count, k + 1);
+      EXPECT_TRUE(onLine(obs, edges[0]) || onLine(obs, edges[1]));
+      if (710 + 25.0 * k > kSize.width) {
+        EXPECT_GT(std::max(obs.start_px.x(), obs.end_px.x()), kSize.width - 6.0);
+      }
+    }
+  }
+  // Steps 2, 3 and 4 predict the right endpoints outside: 2 lines each.
+  EXPECT_EQ(clipped, 6);
+}
+
+TEST(OpticalFlowLineTracker, PredictionClipsAlongTheSlope) {
+  // A slanted bar moving up-right out of the image: a clipped prediction stays on the moved
+  // edge's line and ends on the border.
+  const test::SyntheticLineScene scene(kSize);
+  const std::vector<Bar> bar = {{{600, 160}, {260, 40}, -30}};
+  OpticalFlowLineTracker tracker(test::undistortedCamera(), defaultOptions());
+  tracker.track(scene.render(bar, {0, 0}), 0.0);
+  int clipped = 0;
+  for (int k = 1; k <= 4; ++k) {
+    const cv::Point2d offset(25.0 * k, -25.0 * k);
+    tracker.track(scene.render(bar, offset), 0.05 * k);
+    const auto edges = longEdges(bar[0], offset);
+    for (const auto& p : tracker.lastPredictions()) {
+      if (!p.valid || !p.clipped) continue;
+      ++clipped;
+      const double tol = 1.5;
+      for (const Eigen::Vector2d& q : {p.segment.start, p.segment.end}) {
+        EXPECT_TRUE(edges[0].distanceToLine(q) < tol || edges[1].distanceToLine(q) < tol)
+            << "frame " << k << ": " << q.transpose();
+        EXPECT_TRUE(q.x() >= 0 && q.y() >= 0 && q.x() <= kSize.width - 1 &&
+                    q.y() <= kSize.height - 1);
+      }
+      const double x_max = std::max(p.segment.start.x(), p.segment.end.x());
+      const double y_min = std::min(p.segment.start.y(), p.segment.end.y());
+      EXPECT_TRUE(std::abs(x_max - (kSize.width - 1)) < 1e-9 || std::abs(y_min) < 1e-9);
+    }
+  }
+  EXPECT_GE(clipped, 4);
+}
+
+TEST(DescriptorLineTracker, KeepsIdsOfTranslatedLines) {
+  const test::SyntheticLineScene scene(kSize);
+  DescriptorLineTracker tracker(test::undistortedCamera(), defaultOptions());
+  const LineFrame f1 = tracker.track(scene.render(kBars, {0, 0}), 0.0);
+  const cv::Point2d offset(7.3, -4.6);
+  const LineFrame f2 = tracker.track(scene.render(kBars, offset), 0.05);
+  const auto before = byId(f1);
+  int kept = 0;
+  for (const auto& [id, obs] : byId(f2)) {
+    if (!before.count(id)) continue;
+    ++kept;
+    const Eigen::Vector2d d(offset.x, offset.y);
+    EXPECT_LT(segmentOf(obs).distanceToLine(before.at(id).start_px + d), 2.0) << "wrong match";
+  }
+  EXPECT_GE(kept, static_cast<int>(0.8 * f1.lines.size()));
+  EXPECT_EQ(f2.stats.tracked, kept);
+  EXPECT_EQ(f2.stats.merged, 0);
+}
+
+TEST(DescriptorLineTracker, DoesNotMergeSplitLines) {
+  // The baseline's known limitation: the pieces of a split line stay separate segments.
+  const test::SyntheticLineScene scene(kSize);
+  const std::vector<Bar> bar = {{{376, 240}, {500, 40}, 0}};
+  DescriptorLineTracker tracker(test::undistortedCamera(), defaultOptions());
+  tracker.track(scene.render(bar, {0, 0}), 0.0);
+  const LineFrame f2 = tracker.track(scene.render(bar, {5, 3}, {Occluder{{376, 240}, 30}}), 0.05);
+  EXPECT_EQ(f2.stats.merged, 0);
+  EXPECT_EQ(f2.lines.size(), 4u);
+  EXPECT_GE(f2.stats.new_lines, 2);
+}
+
+TEST(LineTracker, DistortedStraightEdgeComesOutStraightInNormalisedCoordinates) {
+  // A straight bar in normalised coordinates, drawn through EuRoC's distortion (curved in the
+  // raw image, bowed by several pixels near the top).
+  const CameraOptions camera = Config::load(test::sourcePath("config/euroc.yaml")).camera;
+  const auto model = CameraModel::create(camera);
+  const Eigen::Vector2d a(-0.62, -0.40), b(0.58, -0.36);
+  const Eigen::Vector2d u = (b - a).normalized(), n(-u.y(), u.x());
+  const double half = 0.03;
+  cv::Mat raw(kSize, CV_8UC1, cv::Scalar(150));
+  constexpr int kShift = 4;
+  std::vector<cv::Point> poly;
+  auto add = [&](const Eigen::Vector2d& xy) {
+    const Eigen::Vector2d px = model->distort(xy);
+    poly.emplace_back(cvRound(px.x() * (1 << kShift)), cvRound(px.y() * (1 << kShift)));
+  };
+  for (int i = 0; i <= 100; ++i) add(a + (b - a) * (i / 100.0) + half * n);
+  for (int i = 100; i >= 0; --i) add(a + (b - a) * (i / 100.0) - half * n);
+  cv::fillPoly(raw, std::vector<std::vector<cv::Point>>{poly}, cv::Scalar(40), cv::LINE_AA, kShift);
+  const Eigen::Vector2d mid_raw = model->distort(0.5 * (a + b) + half * n);
+  const Eigen::Vector2d end_raw = model->distort(a + half * n);
+  ASSERT_GT(std::abs(mid_raw.y() - end_raw.y()), 5.0) << "the edge should be visibly curved";
+
+  OpticalFlowLineTracker tracker(camera, defaultOptions());
+  const LineFrame f = tracker.track(raw, 0.0);
+  // Each long edge of the bar: one long segment on the normalised edge line.
+  // 2 px: the anti-aliased polygon fill and LSD each move an edge by up to about a pixel;
+  // without undistortion the endpoints would be tens of pixels off this line.
+  const double tol = 2.0 / camera.intrinsics[0];
+  const double edge_length = (b - a).norm();
+  int found = 0;
+  for (const auto& obs : f.lines) {
+    for (double side : {1.0, -1.0}) {
+      const Eigen::Vector2d p0 = a + side * half * n;
+      auto dist = [&](const Eigen::Vector2d& q) { return std::abs(n.dot(q - p0)); };
+      if (dist(obs.start_norm) < tol && dist(obs.end_norm) < tol &&
+          (obs.end_norm - obs.start_norm).norm() > 0.8 * edge_length)
+        ++found;
+    }
+    // Pixel and normalised coordinates agree through K.
+    EXPECT_NEAR(obs.start_norm.x(),
+                (obs.start_px.x() - camera.intrinsics[2]) / camera.intrinsics[0], 1e-12);
+  }
+  EXPECT_EQ(found, 2);
+}
+
+TEST(LineTrackerOptions, LoadFromYamlAndNameBadKeys) {
+  const auto yaml = YamlReader::fromString(
+      "lines:\n  tracker: descriptor\n  detector: {max_lines: 25, lsd_scale: 0.8}\n"
+      "  flow: {samples_per_line: 7}\n",
+      "test.yaml");
+  const LineTrackerOptions o = LineTrackerOptions::load(yaml, "lines");
+  EXPECT_EQ(o.tracker, "descriptor");
+  EXPECT_EQ(o.detector.max_lines, 25);
+  EXPECT_DOUBLE_EQ(o.detector.lsd_scale, 0.8);
+  EXPECT_DOUBLE_EQ(o.detector.min_length_ratio, 0.06);
+  EXPECT_EQ(o.flow.samples_per_line, 7);
+  EXPECT_TRUE(yaml.unknownKeys().empty());
+  EXPECT_EQ(createLineTracker(test::undistortedCamera(), o)->name(), std::string("descriptor"));
+
+  const auto bad = YamlReader::fromString("lines:\n  flow: {klt_window_px: 20}\n", "bad.yaml");
+  try {
+    LineTrackerOptions::load(bad, "lines");
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("bad.yaml"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("lines.flow.klt_window_px"), std::string::npos)
+        << e.what();
+  }
+  const auto bad_tracker = YamlReader::fromString("lines:\n  tracker: magic\n", "t.yaml");
+  EXPECT_THROW(LineTrackerOptions::load(bad_tracker, "lines"), Error);
+}
+
+TEST(LineTracker, EurocFramesAreDetectedAndTracked) {
+  ALVIO_REQUIRE_SHARED_DATA(data);
+  const std::string dir = data + "/euroc_V1_01_easy_10frames_chutsu/frontend/cam0";
+  if (!std::filesystem::is_directory(dir)) GTEST_SKIP() << dir << " not found";
+  std::vector<std::string> files;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) files.push_back(e.path().string());
+  std::sort(files.begin(), files.end());
+  ASSERT_EQ(files.size(), 10u);
+  const CameraOptions camera = Config::load(test::sourcePath("config/euroc.yaml")).camera;
+  for (const std::string type : {"flow", "descriptor"}) {
+    LineTrackerOptions options;
+    options.tracker = type;
+    const auto tracker = createLineTracker(camera, options);
+    int lines = 0, continued = 0, previous = 0;
+    for (std::size_t k = 0; k < files.size(); ++k) {
+      const cv::Mat gray = cv::imread(files[k], cv::IMREAD_GRAYSCALE);
+      ASSERT_FALSE(gray.empty()) << files[k];
+      const LineFrame f = tracker->track(gray, 0.05 * k);
+      byId(f);  // no duplicate IDs
+      EXPECT_EQ(f.stats.tracked + f.stats.new_lines, static_cast<int>(f.lines.size()));
+      if (k > 0) {
+        lines += f.lines.size();
+        continued += f.stats.tracked;
+        EXPECT_LE(f.stats.tracked, previous);
+      }
+      previous = f.lines.size();
+    }
+    // A slow flight at 20 Hz: most lines continue from one frame to the next.
+    EXPECT_GE(lines / 9, 25) << type;
+    EXPECT_GE(continued, 0.5 * lines) << type;
+  }
+}
+
+TEST(LineTrackerOptions, ShippedConfigHasTheLinesSection) {
+  const YamlReader yaml(test::sourcePath("config/euroc.yaml"));
+  const Config config = Config::load(test::sourcePath("config/euroc.yaml"));
+  EXPECT_EQ(config.lines.tracker, "flow");
+  EXPECT_EQ(config.lines.detector.max_lines, 60);
+  EXPECT_EQ(config.lines.flow.samples_per_line, 5);
+  // Every key of the section is read.
+  LineTrackerOptions::load(yaml, "lines");
+  for (const auto& key : yaml.unknownKeys()) EXPECT_NE(key.rfind("lines", 0), 0u) << key;
+}

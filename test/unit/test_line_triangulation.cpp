@@ -1,0 +1,235 @@
+// Two-view and multi-view line triangulation, degeneracy checks, extents and the landmark.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include "alvio/common/error.h"
+#include "alvio/config/yaml_reader.h"
+#include "alvio/geometry/line_landmark.h"
+#include "alvio/geometry/line_projection_factor.h"
+#include "alvio/geometry/line_triangulation.h"
+#include "alvio/geometry/orthonormal_line.h"
+#include "line_test_utils.h"
+
+using namespace alvio;
+
+namespace {
+constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
+
+// A camera at `position` looking at `target` (z forward, x right, y down-ish).
+Eigen::Isometry3d lookAt(const Eigen::Vector3d& position, const Eigen::Vector3d& target) {
+  const Eigen::Vector3d z = (target - position).normalized();
+  const Eigen::Vector3d x = Eigen::Vector3d::UnitZ().cross(z).normalized();
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() << x, z.cross(x), z;
+  T.translation() = position;
+  return T;
+}
+
+Eigen::Vector2d projectNormalised(const Eigen::Isometry3d& T_w_c, const Eigen::Vector3d& p_w) {
+  const Eigen::Vector3d p_c = T_w_c.inverse() * p_w;
+  return p_c.head<2>() / p_c.z();
+}
+
+// A view of the part [a, b] (fractions along P->Q) of the segment, with pixel noise.
+LineView observe(const Eigen::Isometry3d& T_w_c, const Eigen::Vector3d& P, const Eigen::Vector3d& Q,
+                 double a, double b, double noise_norm, std::mt19937& rng) {
+  std::normal_distribution<double> g(0.0, noise_norm);
+  LineView v;
+  v.T_w_c = T_w_c;
+  v.start_norm = projectNormalised(T_w_c, P + a * (Q - P)) + Eigen::Vector2d(g(rng), g(rng));
+  v.end_norm = projectNormalised(T_w_c, P + b * (Q - P)) + Eigen::Vector2d(g(rng), g(rng));
+  return v;
+}
+
+double residualCost(const LineViews& views, const PluckerLine& line_w) {
+  double line[4], pose[7], cost = 0.0;
+  OrthonormalLine::fromPlucker(line_w).toParameters(line);
+  for (const LineView& v : views) {
+    poseToParameters(v.T_w_c, pose);
+    Eigen::Vector2d r;
+    EXPECT_TRUE(LineProjectionFactor(v.start_norm, v.end_norm, Eigen::Isometry3d::Identity())
+                    .residual(pose, line, &r));
+    cost += r.squaredNorm();
+  }
+  return cost;
+}
+
+const Eigen::Vector3d kP(4.0, -1.0, 0.5), kQ(4.5, 1.5, 1.8);  // a 3 m edge ~4.5 m away
+}  // namespace
+
+TEST(LineTriangulation, TwoViewNoiseFreeIsExact) {
+  std::mt19937 rng(21);
+  for (int k = 0; k < 20; ++k) {
+    const Eigen::Isometry3d Ta = lookAt(test::randomVector(rng, 0.5), kP + 0.5 * (kQ - kP));
+    const Eigen::Isometry3d Tb =
+        lookAt(Ta.translation() + test::randomVector(rng, 0.4), kP + 0.4 * (kQ - kP));
+    // Different parts of the segment in each view: only the infinite line is shared.
+    PluckerLine line;
+    const auto status = triangulateLine(observe(Ta, kP, kQ, 0.1, 0.7, 0, rng),
+                                        observe(Tb, kP, kQ, 0.3, 0.95, 0, rng), {}, &line);
+    if (status == LineTriangulationStatus::kNearEpipole ||
+        status == LineTriangulationStatus::kPlanesNearlyParallel)
+      continue;  // a random baseline can be degenerate; that is tested below
+    ASSERT_EQ(status, LineTriangulationStatus::kOk) << toString(status);
+    EXPECT_TRUE(test::sameLine(line, PluckerLine::fromPoints(kP, kQ), 1e-8));
+  }
+}
+
+TEST(LineTriangulation, RejectsBaselineAlongTheLine) {
+  // Moving along the line keeps it in the epipolar plane: both planes are the same.
+  std::mt19937 rng(22);
+  const Eigen::Isometry3d Ta = lookAt({0, 0, 0}, kP);
+  Eigen::Isometry3d Tb = Ta;
+  Tb.translation() += 0.5 * (kQ - kP).normalized();
+  PluckerLine line;
+  const auto status = triangulateLine(observe(Ta, kP, kQ, 0.1, 0.7, 0, rng),
+                                      observe(Tb, kP, kQ, 0.1, 0.7, 0, rng), {}, &line);
+  EXPECT_TRUE(status == LineTriangulationStatus::kNearEpipole ||
+              status == LineTriangulationStatus::kPlanesNearlyParallel)
+      << toString(status);
+}
+
+TEST(LineTriangulation, RejectsTinyBaselineAndSmallPlaneAngle) {
+  std::mt19937 rng(23);
+  const Eigen::Isometry3d Ta = lookAt({0, 0, 0}, kP);
+  Eigen::Isometry3d Tb = lookAt({0, 0, 0}, kQ);  // pure rotation
+  PluckerLine line;
+  EXPECT_EQ(triangulateLine(observe(Ta, kP, kQ, 0, 1, 0, rng), observe(Tb, kP, kQ, 0, 1, 0, rng),
+                            {}, &line),
+            LineTriangulationStatus::kBaselineTooSmall);
+  // A 2 cm baseline sideways at 4.5 m: plane angle ~0.25 deg, below a 1 deg threshold but
+  // fine for a 0.1 deg one.
+  Tb = Ta;
+  Tb.translation() += 0.02 * Ta.linear().col(0);
+  LineTriangulationOptions options;
+  options.min_epipole_angle_deg = 0.0;
+  const LineView a = observe(Ta, kP, kQ, 0, 1, 0, rng), b = observe(Tb, kP, kQ, 0, 1, 0, rng);
+  EXPECT_EQ(triangulateLine(a, b, options, &line), LineTriangulationStatus::kPlanesNearlyParallel);
+  options.min_plane_angle_deg = 0.1;
+  EXPECT_EQ(triangulateLine(a, b, options, &line), LineTriangulationStatus::kOk);
+}
+
+TEST(LineTriangulation, RejectsAnIntersectionBehindTheCameras) {
+  // Two cameras looking along +z, 1 m apart in x; the "same" vertical line is seen at
+  // x = 0.1 z from the first and at x - 1 = 0.3 z from the second: they meet at z = -5.
+  Eigen::Isometry3d Ta = Eigen::Isometry3d::Identity(), Tb = Eigen::Isometry3d::Identity();
+  Tb.translation() = Eigen::Vector3d(1, 0, 0);
+  LineView a, b;
+  a.T_w_c = Ta;
+  a.start_norm = {0.1, -0.2};
+  a.end_norm = {0.1, 0.2};
+  b.T_w_c = Tb;
+  b.start_norm = {0.3, -0.2};
+  b.end_norm = {0.3, 0.2};
+  PluckerLine line;
+  EXPECT_EQ(triangulateLine(a, b, {}, &line), LineTriangulationStatus::kBehindCamera);
+}
+
+// Eight views moving across the line (it runs mostly along y and z, seen along x).
+LineViews sweep(double noise, std::mt19937& rng) {
+  LineViews views;
+  for (int i = 0; i < 8; ++i) {
+    const Eigen::Vector3d position(0.05 * std::sin(i), 0.3 - 0.06 * i, -0.4 + 0.12 * i);
+    views.push_back(observe(lookAt(position, kP + 0.5 * (kQ - kP)), kP, kQ, 0.05 * (i % 3),
+                            1.0 - 0.04 * (i % 4), noise, rng));
+  }
+  return views;
+}
+
+double median(std::vector<double> v) {
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+TEST(LineTriangulation, MultiViewNoiseFreeIsExact) {
+  std::mt19937 rng(30);
+  PluckerLine line;
+  ASSERT_EQ(triangulateLineMultiView(sweep(0.0, rng), {}, &line), LineTriangulationStatus::kOk);
+  EXPECT_TRUE(test::sameLine(line, PluckerLine::fromPoints(kP, kQ), 1e-8));
+}
+
+TEST(LineTriangulation, MultiViewRefinementImprovesOnTheBestPair) {
+  // 1 px endpoint noise, 0.8 m baseline at 4.5 m: the refined line is the least-squares one,
+  // so it lowers the cost of every trial and the error on average.
+  const double noise = 1.0 / 458.0;
+  const PluckerLine truth = PluckerLine::fromPoints(kP, kQ);
+  const Eigen::Vector3d mid = 0.5 * (kP + kQ);
+  std::vector<double> seed_angle, refined_angle, seed_dist, refined_dist;
+  for (int k = 0; k < 30; ++k) {
+    std::mt19937 rng(100 + k);
+    const LineViews views = sweep(noise, rng);
+    LineTriangulationOptions no_refine;
+    no_refine.refine_max_iterations = 0;
+    PluckerLine seed, refined;
+    ASSERT_EQ(triangulateLineMultiView(views, no_refine, &seed), LineTriangulationStatus::kOk);
+    ASSERT_EQ(triangulateLineMultiView(views, {}, &refined), LineTriangulationStatus::kOk);
+    EXPECT_LT(residualCost(views, refined), residualCost(views, seed));
+    seed_angle.push_back(lineAngle(seed, truth) * kRadToDeg);
+    refined_angle.push_back(lineAngle(refined, truth) * kRadToDeg);
+    seed_dist.push_back(seed.distanceTo(mid));
+    refined_dist.push_back(refined.distanceTo(mid));
+  }
+  auto mean = [](const std::vector<double>& v) {
+    return std::accumulate(v.begin(), v.end(), 0.0) / v.size();
+  };
+  RecordProperty("median_angle_deg", std::to_string(median(refined_angle)));
+  RecordProperty("median_midpoint_distance_m", std::to_string(median(refined_dist)));
+  EXPECT_LT(median(refined_angle), 1.0);
+  EXPECT_LT(median(refined_dist), 0.05);
+  EXPECT_LT(mean(refined_angle), mean(seed_angle));
+  EXPECT_LT(mean(refined_dist), mean(seed_dist));
+}
+
+TEST(LineTriangulation, MultiViewNeedsTwoViews) {
+  LineViews views(1);
+  PluckerLine line;
+  EXPECT_EQ(triangulateLineMultiView(views, {}, &line), LineTriangulationStatus::kTooFewViews);
+}
+
+TEST(LineTriangulation, ExtentIsTheUnionOfTheObservedParts) {
+  std::mt19937 rng(24);
+  LineViews views = {observe(lookAt({0, -0.5, 0}, kP), kP, kQ, 0.2, 0.6, 0, rng),
+                     observe(lookAt({0.2, 0.3, 0.1}, kQ), kP, kQ, 0.9, 0.4, 0, rng)};
+  Eigen::Vector3d start, end;
+  const PluckerLine truth = PluckerLine::fromPoints(kP, kQ);
+  ASSERT_TRUE(lineExtent(truth, views, &start, &end));
+  EXPECT_LT((start - (kP + 0.2 * (kQ - kP))).norm(), 1e-9);
+  EXPECT_LT((end - (kP + 0.9 * (kQ - kP))).norm(), 1e-9);
+}
+
+TEST(LineLandmark, ExtentGrowsAndFollowsTheLine) {
+  LineLandmark lm;
+  lm.id = 7;
+  EXPECT_FALSE(lm.hasLine());
+  lm.setLine(PluckerLine::fromPoints({0, 0, 1}, {1, 0, 1}), LineLandmarkStatus::kTriangulated);
+  EXPECT_TRUE(lm.hasLine());
+  lm.unionExtent({0.2, 0.1, 1}, {0.5, 0, 1});  // off-line points are projected
+  lm.unionExtent({0.4, 0, 1}, {-0.3, 0, 1});
+  EXPECT_LT((lm.start_w - Eigen::Vector3d(-0.3, 0, 1)).norm(), 1e-12);
+  EXPECT_LT((lm.end_w - Eigen::Vector3d(0.5, 0, 1)).norm(), 1e-12);
+  // A refined line moves the extent onto it.
+  lm.setLine(PluckerLine::fromPoints({0, 0, 1.1}, {1, 0, 1.1}), LineLandmarkStatus::kOptimised);
+  EXPECT_NEAR(lm.start_w.z(), 1.1, 1e-12);
+  EXPECT_NEAR(lm.end_w.x(), 0.5, 1e-12);
+  EXPECT_STREQ(toString(lm.status), "optimised");
+}
+
+TEST(LineTriangulationOptions, LoadFromYamlAndNameBadKeys) {
+  const auto yaml = YamlReader::fromString(
+      "lines:\n  triangulation: {min_plane_angle_deg: 2.5, refine_huber_scale: 0.01}\n", "t.yaml");
+  const auto o = LineTriangulationOptions::load(yaml, "lines.triangulation");
+  EXPECT_DOUBLE_EQ(o.min_plane_angle_deg, 2.5);
+  EXPECT_DOUBLE_EQ(o.refine_huber_scale, 0.01);
+  EXPECT_DOUBLE_EQ(o.min_depth, LineTriangulationOptions().min_depth);
+  const auto bad = YamlReader::fromString("tri: {min_baseline: -1}\n", "bad.yaml");
+  try {
+    LineTriangulationOptions::load(bad, "tri");
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("bad.yaml"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("tri.min_baseline"), std::string::npos) << e.what();
+  }
+}
