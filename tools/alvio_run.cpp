@@ -21,10 +21,19 @@ int main(int argc, char** argv) {
   args.option("config", "YAML configuration", Config::defaultPath());
   args.option("out", "output folder", "", true);
   args.option("max-frames", "stop after this many images", "-1");
+  args.flag("no-lines", "points only (no line front end, no line landmarks)");
+  args.option("line-tracker", "flow (ALVIO optical flow) | descriptor (PL-VIO LBD baseline)");
   args.flag("quiet", "no progress bar");
   try {
     if (!args.parse(argc, argv)) return 0;
-    const Config config = Config::load(args.get("config"));
+    Config config = Config::load(args.get("config"));
+    if (args.isSet("no-lines")) config.estimator.use_lines = false;
+    if (args.isSet("line-tracker")) {
+      config.lines.tracker = args.get("line-tracker");
+      if (config.lines.tracker != "flow" && config.lines.tracker != "descriptor")
+        throw Error("--line-tracker must be flow or descriptor, got '" + config.lines.tracker +
+                    "'");
+    }
     std::unique_ptr<SensorSource> source;
     const std::string dataset = args.get("dataset");
     if (std::filesystem::path(dataset).extension() == ".bag")

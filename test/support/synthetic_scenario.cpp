@@ -30,6 +30,23 @@ SyntheticScenario::SyntheticScenario(const ScenarioOptions& options, const Camer
       p = {u(rng_), u(rng_), 4};
     landmarks_.push_back(p);
   }
+  // Horizontal and vertical segments (door frames, shelves, pipes) on the walls.
+  std::uniform_real_distribution<double> len(0.6, 2.0);
+  for (int i = 0; i < 300; ++i) {
+    const int face = i % 4;
+    const double a = u(rng_) * 0.8, z = h(rng_) * 0.8 + 0.3, l = len(rng_);
+    const bool vertical = (i / 4) % 2 == 0;
+    Eigen::Vector3d p0, dir;
+    if (face == 0)
+      p0 = {6, a, z}, dir = vertical ? Eigen::Vector3d(0, 0, 1) : Eigen::Vector3d(0, 1, 0);
+    else if (face == 1)
+      p0 = {-6, a, z}, dir = vertical ? Eigen::Vector3d(0, 0, 1) : Eigen::Vector3d(0, 1, 0);
+    else if (face == 2)
+      p0 = {a, 6, z}, dir = vertical ? Eigen::Vector3d(0, 0, 1) : Eigen::Vector3d(1, 0, 0);
+    else
+      p0 = {a, -6, z}, dir = vertical ? Eigen::Vector3d(0, 0, 1) : Eigen::Vector3d(1, 0, 0);
+    segments_.emplace_back(p0 - 0.5 * l * dir, p0 + 0.5 * l * dir);
+  }
   makeImu(imu);
   makeFrames(camera);
 }
@@ -45,10 +62,14 @@ Eigen::Matrix3d SyntheticScenario::rotation(double t) const {
   const double yaw = 0.6 * std::sin(0.3 * t) + 0.2 * t;
   const double pitch = 0.1 * std::sin(0.9 * t);
   const double roll = 0.1 * std::cos(0.8 * t);
+  // Mounted as on the EuRoC MAV: body x up, body z (the camera's axis) forward.
+  Eigen::Matrix3d R0;
+  R0 << 0, 0, 1, 0, -1, 0, 1, 0, 0;
   return (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
           Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
           Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
-      .toRotationMatrix();
+             .toRotationMatrix() *
+         R0;
 }
 
 Eigen::Vector3d SyntheticScenario::velocity(double t) const {
@@ -125,6 +146,7 @@ void SyntheticScenario::makeFrames(const CameraOptions& camera) {
       now.insert(id);
     }
     tracked = now;
+    addLines(T_c_w, camera, &frame);
     frames_.push_back(frame);
   }
 }
@@ -139,6 +161,53 @@ Trajectory SyntheticScenario::groundTruth() const {
     gt.push_back(p);
   }
   return gt;
+}
+
+}  // namespace alvio::test
+
+namespace alvio::test {
+
+void SyntheticScenario::addLines(const Eigen::Isometry3d& T_c_w, const CameraOptions& camera,
+                                 FeatureFrame* frame) {
+  if (options_.max_lines <= 0) return;
+  const double fx = camera.intrinsics[0], fy = camera.intrinsics[1];
+  const double cx = camera.intrinsics[2], cy = camera.intrinsics[3];
+  std::normal_distribution<double> n(0, options_.line_noise);
+  std::uniform_real_distribution<double> shrink(0.0, 0.05);
+  std::vector<int> visible;
+  for (int i = 0; i < static_cast<int>(segments_.size()); ++i) {
+    const Eigen::Vector3d a = T_c_w * segments_[i].first, b = T_c_w * segments_[i].second;
+    if (a.z() < 0.5 || b.z() < 0.5) continue;
+    const Eigen::Vector2d pa(fx * a.x() / a.z() + cx, fy * a.y() / a.z() + cy);
+    const Eigen::Vector2d pb(fx * b.x() / b.z() + cx, fy * b.y() / b.z() + cy);
+    auto inside = [&](const Eigen::Vector2d& p) {
+      return p.x() > 5 && p.y() > 5 && p.x() < camera.width - 5 && p.y() < camera.height - 5;
+    };
+    if (inside(pa) && inside(pb) && (pa - pb).norm() > 40) visible.push_back(i);
+  }
+  std::stable_partition(visible.begin(), visible.end(),
+                        [&](int i) { return tracked_lines_.count(i) > 0; });
+  if (static_cast<int>(visible.size()) > options_.max_lines) visible.resize(options_.max_lines);
+  std::set<int> now;
+  for (int i : visible) {
+    if (!tracked_lines_.count(i)) line_track_id_[i] = next_line_id_++;
+    const Eigen::Vector3d a = T_c_w * segments_[i].first, b = T_c_w * segments_[i].second;
+    Eigen::Vector2d pa(fx * a.x() / a.z() + cx, fy * a.y() / a.z() + cy);
+    Eigen::Vector2d pb(fx * b.x() / b.z() + cx, fy * b.y() / b.z() + cy);
+    // Detected endpoints wander along the line and jitter across it.
+    const Eigen::Vector2d dir = (pb - pa).normalized(), normal(-dir.y(), dir.x());
+    const Eigen::Vector2d sa = pa + shrink(rng_) * (pb - pa) + n(rng_) * normal;
+    const Eigen::Vector2d sb = pb - shrink(rng_) * (pb - pa) + n(rng_) * normal;
+    LineObservation o;
+    o.id = line_track_id_[i];
+    o.start_px = sa;
+    o.end_px = sb;
+    o.start_norm = Eigen::Vector2d((sa.x() - cx) / fx, (sa.y() - cy) / fy);
+    o.end_norm = Eigen::Vector2d((sb.x() - cx) / fx, (sb.y() - cy) / fy);
+    frame->lines.push_back(o);
+    now.insert(i);
+  }
+  tracked_lines_ = now;
 }
 
 }  // namespace alvio::test

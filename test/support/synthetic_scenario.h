@@ -4,7 +4,10 @@
 // and point observations of landmarks on the walls of a room, with stable IDs.
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <map>
 #include <random>
+#include <set>
 #include <vector>
 
 #include "alvio/common/types.h"
@@ -20,6 +23,8 @@ struct ScenarioOptions {
   double pixel_noise = 0.5;  ///< sigma, pixels
   bool imu_noise = true;
   int max_points = 150;
+  int max_lines = 40;       ///< line observations per frame (0: none)
+  double line_noise = 0.5;  ///< endpoint noise across the line, pixels
   unsigned seed = 1;
 };
 
@@ -35,18 +40,27 @@ class SyntheticScenario {
 
   const std::vector<ImuSample>& imu() const { return imu_; }
   const std::vector<FeatureFrame>& frames() const { return frames_; }
+  /// The true 3D segments the line observations come from.
+  const std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>>& lineSegments() const {
+    return segments_;
+  }
   Trajectory groundTruth() const;
   static constexpr int64_t kStartNs = 1000000000000LL;  // t = 0 maps to 1000 s
 
  private:
   void makeImu(const ImuOptions& imu);
   void makeFrames(const CameraOptions& camera);
+  void addLines(const Eigen::Isometry3d& T_c_w, const CameraOptions& camera, FeatureFrame* frame);
 
   ScenarioOptions options_;
   std::mt19937 rng_;
   std::vector<Eigen::Vector3d> landmarks_;
+  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> segments_;
   std::vector<ImuSample> imu_;
   std::vector<FeatureFrame> frames_;
+  std::set<int> tracked_lines_;
+  std::map<int, int> line_track_id_;
+  int next_line_id_ = 0;
 };
 
 }  // namespace alvio::test

@@ -147,3 +147,28 @@ TEST(Marginalization, PriorJacobiansMatchNumericAndKeepsInformation) {
   const auto blocks = info->keptBlocks({{pose1, shifted1}, {pose2, shifted2}});
   EXPECT_EQ(blocks, (std::vector<double*>{shifted1, shifted2}));
 }
+
+// The prior must not care about the sign of a quaternion parameter.
+TEST(Marginalization, PriorIgnoresQuaternionSign) {
+  const Eigen::Isometry3d T_b_c = eurocTbc();
+  double pose0[7], pose1[7], pose2[7], inv_depth[1] = {0.25};
+  setPose(pose0, Eigen::Vector3d(0, 0, 0), Eigen::Quaterniond::Identity());
+  setPose(pose1, Eigen::Vector3d(0.2, 0.1, 0), expQuaternion(Eigen::Vector3d(0.02, 0.05, 0.01)));
+  setPose(pose2, Eigen::Vector3d(0.4, 0.1, 0.1), expQuaternion(Eigen::Vector3d(0.03, 0.1, 0.0)));
+  auto info = std::make_shared<MarginalizationInfo>();
+  info->addResidualBlock(new PointProjectionFactor({0.1, 0.05}, {0.05, 0.06}, T_b_c, 100.0),
+                         nullptr, {pose0, pose1, inv_depth}, {0, 2});
+  info->addResidualBlock(new PointProjectionFactor({0.1, 0.05}, {0.02, 0.055}, T_b_c, 100.0),
+                         nullptr, {pose0, pose2, inv_depth}, {0, 2});
+  ASSERT_TRUE(info->marginalize());
+  MarginalizationFactor prior(info);
+  pose1[1] += 0.01;
+  const int n = info->keptTangentSize();
+  Eigen::VectorXd r1(n), r2(n);
+  const double* params[] = {pose1, pose2};
+  prior.Evaluate(params, r1.data(), nullptr);
+  for (int i = 3; i < 7; ++i) pose2[i] = -pose2[i];
+  prior.Evaluate(params, r2.data(), nullptr);
+  EXPECT_LT((r1 - r2).norm(), 1e-12);
+  EXPECT_LT(test::checkJacobians(prior, {pose1, pose2}).max_rel_error, 1e-6);
+}

@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "alvio/common/error.h"
 #include "alvio/common/logging.h"
 #include "alvio/common/rotation.h"
 #include "alvio/estimator/factors/marginalization.h"
@@ -17,8 +18,10 @@ Estimator::Estimator(const EstimatorOptions& options, const CameraOptions& camer
       gravity_(0, 0, -imu.gravity_magnitude),
       W_(options.window_size),
       points_(options.window_size, options.keyframe_parallax_px / camera.intrinsics[0]),
+      lines_(options.line_min_observations, options.line_triangulation),
       para_pose_(options.window_size + 1),
       para_speed_bias_(options.window_size + 1) {
+  lines_.setObservationSigma(options.line_sigma_px / camera.intrinsics[0]);
   clearState();
 }
 
@@ -37,6 +40,7 @@ ImuNoise Estimator::imuNoise() const {
 void Estimator::clearState() {
   const int n = W_ + 1;
   headers_.assign(n, 0.0);
+  header_ns_.assign(n, 0);
   Ps_.assign(n, Eigen::Vector3d::Zero());
   Vs_.assign(n, Eigen::Vector3d::Zero());
   Bas_.assign(n, Eigen::Vector3d::Zero());
@@ -48,6 +52,7 @@ void Estimator::clearState() {
   acc_buf_.assign(n, {});
   gyr_buf_.assign(n, {});
   points_.clear();
+  lines_.clear();
   last_marginalization_.reset();
   last_marginalization_blocks_.clear();
   all_frames_.clear();
@@ -57,6 +62,7 @@ void Estimator::clearState() {
   frame_count_ = 0;
   last_init_attempt_ = -1e9;
   last_wait_reason_.clear();
+  bias_prior_pending_ = false;
 }
 
 void Estimator::event(EstimatorEvent::Kind kind, double t, const std::string& message) {
@@ -170,6 +176,8 @@ bool Estimator::addFrame(const FeatureFrame& frame, FrameTiming* timing) {
                          ? Marginalization::kOld
                          : Marginalization::kSecondNew;
   headers_[frame_count_] = t;
+  header_ns_[frame_count_] = frame.t_ns;
+  if (options_.use_lines) lines_.addFrame(frame.t_ns, frame.lines);
 
   ImageFrame image;
   for (const auto& o : frame.points) image.xy1[o.id] = Eigen::Vector3d(o.xy.x(), o.xy.y(), 1.0);
@@ -200,7 +208,28 @@ bool Estimator::addFrame(const FeatureFrame& frame, FrameTiming* timing) {
       return false;
     }
     status_ = EstimatorStatus::kTracking;
-    optimize(timing);
+    // Initialisation ends with a first visual-inertial optimisation of the aligned window,
+    // given more iterations than the per-frame ones: the linear alignment is only a start.
+    optimize(timing, 3 * options_.max_iterations);
+    // A window with too little excitation can align to a wrong gravity; the refinement then
+    // pushes the error into the accelerometer bias. Reject such an initialisation and wait.
+    if (Bas_[W_].norm() > options_.init_max_accel_bias || !Ps_[W_].allFinite()) {
+      const std::string why = "initialisation rejected: accelerometer bias " +
+                              std::to_string(Bas_[W_].norm()) + " m/s^2 after refinement";
+      logInfo(why);
+      event(EstimatorEvent::Kind::kWaiting, t, why);
+      const Eigen::Vector3d bg = Bgs_[W_];
+      clearState();
+      for (auto& b : Bgs_) b = bg.allFinite() ? bg : Eigen::Vector3d::Zero();
+      return false;
+    }
+    EstimatorEvent e;
+    e.kind = EstimatorEvent::Kind::kInitialized;
+    e.t = t;
+    e.window = windowStates();
+    e.scale = init_scale_;
+    e.message = "initialised";
+    events_.push_back(std::move(e));
     {
       ScopedStage stage(timing, "marginalization");
       marginalize();
@@ -210,11 +239,13 @@ bool Estimator::addFrame(const FeatureFrame& frame, FrameTiming* timing) {
     last_R_ = Rs_[W_];
     last_P_ = Ps_[W_];
   } else {
-    if (points_.lastTrackedCount() < options_.min_tracked_points) {
-      reset(t, "only " + std::to_string(points_.lastTrackedCount()) + " points tracked");
+    const int tracked = points_.lastTrackedCount() + lines_.lastTrackedCount();
+    if (tracked < options_.min_tracked_features) {
+      reset(t, "only " + std::to_string(points_.lastTrackedCount()) + " points and " +
+                   std::to_string(lines_.lastTrackedCount()) + " lines tracked");
       return false;
     }
-    optimize(timing);
+    optimize(timing, options_.max_iterations);
     std::string why;
     if (detectFailure(&why)) {
       reset(t, why);
@@ -232,7 +263,7 @@ bool Estimator::addFrame(const FeatureFrame& frame, FrameTiming* timing) {
   // Output continuity: after a reset, anchor the new world frame on the dead-reckoned pose.
   if (align_output_after_reset_) {
     align_output_after_reset_ = false;
-    out_yaw_ = yawOf(dead_reckoned_.q.toRotationMatrix()) - yawOf(Rs_[W_]);
+    out_yaw_ = yawAlignment(dead_reckoned_.q.toRotationMatrix(), Rs_[W_]);
     out_from_ = Ps_[W_];
     out_to_ = dead_reckoned_.p;
     logInfo("output re-anchored after ", dead_reckoned_.t - last_output_.t,
@@ -286,11 +317,14 @@ void Estimator::reset(double t, const std::string& why) {
 void Estimator::slideWindow() {
   if (marginalization_ == Marginalization::kOld) {
     const double t0 = headers_[0];
+    const int64_t t0_exact_ns = header_ns_[0];
+    const Eigen::Isometry3d T_w_c0 = cameraPose(t0_exact_ns);
     back_R0_ = Rs_[0];
     back_P0_ = Ps_[0];
     if (frame_count_ == W_) {
       for (int i = 0; i < W_; ++i) {
         headers_[i] = headers_[i + 1];
+        header_ns_[i] = header_ns_[i + 1];
         Ps_[i] = Ps_[i + 1];
         Vs_[i] = Vs_[i + 1];
         Rs_[i] = Rs_[i + 1];
@@ -311,6 +345,7 @@ void Estimator::slideWindow() {
       // (1 us of slack: t0 went through double seconds and lost a few ns.)
       const int64_t t0_ns = secToNs(t0) + 1000;
       all_frames_.erase(all_frames_.begin(), all_frames_.upper_bound(t0_ns));
+      lines_.removeFrame(t0_exact_ns, T_w_c0);
       if (status_ == EstimatorStatus::kTracking) {
         const Eigen::Matrix3d R_c_old = back_R0_ * T_b_c_.linear();
         const Eigen::Vector3d p_c_old = back_P0_ + back_R0_ * T_b_c_.translation();
@@ -329,7 +364,9 @@ void Estimator::slideWindow() {
       acc_buf_[W_ - 1].push_back(acc_buf_[W_][k]);
       gyr_buf_[W_ - 1].push_back(gyr_buf_[W_][k]);
     }
+    lines_.removeFrame(header_ns_[W_ - 1], cameraPose(header_ns_[W_ - 1]));
     headers_[W_ - 1] = headers_[W_];
+    header_ns_[W_ - 1] = header_ns_[W_];
     Ps_[W_ - 1] = Ps_[W_];
     Vs_[W_ - 1] = Vs_[W_];
     Rs_[W_ - 1] = Rs_[W_];
@@ -376,6 +413,55 @@ std::vector<BodyState, Eigen::aligned_allocator<BodyState>> Estimator::windowSta
     s.ba = Bas_[i];
     s.bg = Bgs_[i];
     out.push_back(toOutput(s));
+  }
+  return out;
+}
+
+Eigen::Isometry3d Estimator::cameraPose(int64_t frame_ns) const {
+  for (int i = 0; i <= frame_count_; ++i)
+    if (header_ns_[i] == frame_ns) {
+      Eigen::Isometry3d T_w_b = Eigen::Isometry3d::Identity();
+      T_w_b.linear() = Rs_[i];
+      T_w_b.translation() = Ps_[i];
+      return T_w_b * T_b_c_;
+    }
+  throw Error("estimator: no window frame at " + std::to_string(frame_ns) + " ns");
+}
+
+LineSegments3 Estimator::lineSegments(double max_direction_std_deg) const {
+  LineSegments3 out;
+  if (status_ != EstimatorStatus::kTracking) return out;
+  for (const auto& [id, l] : lines_.landmarks()) {
+    if (!lines_.usable(l) || !l.has_extent) continue;
+    if (max_direction_std_deg > 0 &&
+        (l.direction_std_deg < 0 || l.direction_std_deg > max_direction_std_deg))
+      continue;
+    LineSegment3 seg;
+    seg.id = id;
+    BodyState a, b;
+    a.p = l.start_w;
+    b.p = l.end_w;
+    seg.start = toOutput(a).p;
+    seg.end = toOutput(b).p;
+    seg.observations = static_cast<int>(l.observations.size());
+    seg.direction_std_deg = l.direction_std_deg;
+    out.push_back(seg);
+  }
+  return out;
+}
+
+LineSegments3 Estimator::takeRetiredLines() {
+  LineSegments3 out;
+  for (const LineLandmark& l : lines_.takeRetired()) {
+    LineSegment3 seg;
+    seg.id = l.id;
+    BodyState a, b;
+    a.p = l.start_w;
+    b.p = l.end_w;
+    seg.start = toOutput(a).p;
+    seg.end = toOutput(b).p;
+    seg.direction_std_deg = l.direction_std_deg;
+    out.push_back(seg);
   }
   return out;
 }

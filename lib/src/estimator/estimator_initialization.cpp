@@ -15,13 +15,6 @@ namespace alvio {
 bool Estimator::initialize(double t) {
   if (!initialStructure(t)) return false;
   if (!alignWithImu(t)) return false;
-  EstimatorEvent e;
-  e.kind = EstimatorEvent::Kind::kInitialized;
-  e.t = t;
-  e.window = windowStates();
-  e.scale = init_scale_;
-  e.message = "initialised";
-  events_.push_back(std::move(e));
   last_wait_reason_.clear();
   return true;
 }
@@ -186,6 +179,8 @@ bool Estimator::alignWithImu(double t) {
     if (preintegrations_[i]) preintegrations_[i]->repropagate(Eigen::Vector3d::Zero(), Bgs_[i]);
   const double s = result.scale;
   init_scale_ = s;
+  bias_prior_pending_ = options_.init_accel_bias_sigma > 0;
+  bias_prior_bg_ = result.gyro_bias;
   const Eigen::Vector3d t_b_c = T_b_c_.translation();
   for (int i = frame_count_; i >= 0; --i)
     Ps_[i] = s * Ps_[i] - Rs_[i] * t_b_c - (s * Ps_[0] - Rs_[0] * t_b_c);
@@ -196,9 +191,10 @@ bool Estimator::alignWithImu(double t) {
     ++all_index;
   }
   const Eigen::Matrix3d R0 = gravityAlignedRotation(result.gravity_c0);
-  const double yaw = yawOf(R0 * Rs_[0]);
+  // World yaw: the first keyframe's orientation as close to identity as gravity allows.
+  const double yaw = yawAlignment(Eigen::Matrix3d::Identity(), R0 * Rs_[0]);
   const Eigen::Matrix3d rot =
-      Eigen::AngleAxisd(-yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix() * R0;
+      Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix() * R0;
   for (int i = 0; i <= frame_count_; ++i) {
     Ps_[i] = rot * Ps_[i];
     Rs_[i] = rot * Rs_[i];

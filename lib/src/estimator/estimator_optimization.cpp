@@ -4,15 +4,21 @@
 #include <ceres/problem.h>
 #include <ceres/solver.h>
 
+#include <Eigen/LU>
 #include <cmath>
 
 #include "alvio/common/logging.h"
 #include "alvio/common/rotation.h"
 #include "alvio/estimator/estimator.h"
+#include "alvio/estimator/factors/bias_prior_factor.h"
 #include "alvio/estimator/factors/imu_factor.h"
 #include "alvio/estimator/factors/marginalization.h"
 #include "alvio/estimator/factors/point_projection_factor.h"
 #include "alvio/estimator/pose_manifold.h"
+#include "alvio/geometry/line_projection_factor.h"
+#include "alvio/geometry/line_triangulation.h"
+#include "alvio/geometry/orthonormal_line.h"
+#include "alvio/geometry/orthonormal_line_manifold.h"
 
 namespace alvio {
 namespace {
@@ -38,22 +44,24 @@ void Estimator::statesToParameters() {
   }
   const Eigen::VectorXd inv = points_.inverseDepths();
   para_inv_depth_.assign(inv.data(), inv.data() + inv.size());
+  para_line_.clear();
+  for (const auto& [id, l] : lines_.landmarks()) {
+    if (!lines_.usable(l)) continue;
+    para_line_.emplace_back();
+    OrthonormalLine::fromPlucker(l.line_w).toParameters(para_line_.back().data());
+  }
 }
 
 void Estimator::parametersToStates() {
   // The window is only constrained up to a yaw and a translation (plus the prior): keep the
   // oldest keyframe's yaw and position where they were, so the output does not wander.
   const Eigen::Vector3d origin_P0 = Ps_[0];
-  const double origin_yaw = yawOf(Rs_[0]);
   const Eigen::Matrix3d R0_new =
       Eigen::Quaterniond(para_pose_[0][6], para_pose_[0][3], para_pose_[0][4], para_pose_[0][5])
           .normalized()
           .toRotationMatrix();
-  Eigen::Matrix3d rot_diff =
-      Eigen::AngleAxisd(origin_yaw - yawOf(R0_new), Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  // Near pitch +-90 deg yaw is ill-defined: rotate by the full difference instead.
-  const double pitch = std::asin(std::clamp(-R0_new(2, 0), -1.0, 1.0)) * 180.0 / M_PI;
-  if (std::abs(std::abs(pitch) - 90.0) < 1.0) rot_diff = Rs_[0] * R0_new.transpose();
+  const Eigen::Matrix3d rot_diff =
+      Eigen::AngleAxisd(yawAlignment(Rs_[0], R0_new), Eigen::Vector3d::UnitZ()).toRotationMatrix();
   const Eigen::Vector3d P0_new(para_pose_[0][0], para_pose_[0][1], para_pose_[0][2]);
   for (int i = 0; i <= W_; ++i) {
     const Eigen::Quaterniond q(para_pose_[i][6], para_pose_[i][3], para_pose_[i][4],
@@ -70,12 +78,13 @@ void Estimator::parametersToStates() {
       Eigen::Map<const Eigen::VectorXd>(para_inv_depth_.data(), para_inv_depth_.size()));
 }
 
-void Estimator::optimize(FrameTiming* timing) {
+void Estimator::optimize(FrameTiming* timing, int max_iterations) {
   {
     ScopedStage stage(timing, "triangulation");
     std::vector<Eigen::Vector3d> P(Ps_.begin(), Ps_.end());
     std::vector<Eigen::Matrix3d> R(Rs_.begin(), Rs_.end());
     points_.triangulate(P, R, T_b_c_);
+    if (options_.use_lines) lines_.triangulate([this](int64_t ns) { return cameraPose(ns); });
   }
   ScopedStage stage(timing, "optimization");
   statesToParameters();
@@ -91,6 +100,11 @@ void Estimator::optimize(FrameTiming* timing) {
   if (last_marginalization_)
     problem.AddResidualBlock(new MarginalizationFactor(last_marginalization_), nullptr,
                              last_marginalization_blocks_);
+  if (bias_prior_pending_)
+    problem.AddResidualBlock(
+        new BiasPriorFactor(Eigen::Vector3d::Zero(), bias_prior_bg_, options_.init_accel_bias_sigma,
+                            options_.init_gyro_bias_sigma),
+        nullptr, para_speed_bias_[0].data());
   for (int i = 0; i < frame_count_; ++i) {
     const int j = i + 1;
     if (preintegrations_[j]->sumDt() > kMaxImuFactorSpan) continue;
@@ -114,17 +128,43 @@ void Estimator::optimize(FrameTiming* timing) {
     }
   }
   last_point_residuals_ = residuals;
+  // Lines: one factor per window observation, on the observing frame's pose.
+  int line_residuals = 0;
+  if (options_.use_lines) {
+    auto* line_manifold = new OrthonormalLineManifold();  // owned by the problem
+    const double line_sqrt_info = camera_.intrinsics[0] / options_.line_sigma_px;
+    std::map<int64_t, int> slot;
+    for (int i = 0; i <= frame_count_; ++i) slot[header_ns_[i]] = i;
+    std::size_t k = 0;
+    for (const auto& [id, l] : lines_.landmarks()) {
+      if (!lines_.usable(l)) continue;
+      double* line_block = para_line_[k++].data();
+      problem.AddParameterBlock(line_block, OrthonormalLine::kParameterSize, line_manifold);
+      for (const auto& [ns, obs] : l.observations) {
+        problem.AddResidualBlock(
+            new LineProjectionFactor(obs.start_norm, obs.end_norm, T_b_c_, line_sqrt_info),
+            loss.get(), para_pose_[slot.at(ns)].data(), line_block);
+        ++line_residuals;
+      }
+    }
+  }
+  last_line_residuals_ = line_residuals;
 
   ceres::Solver::Options options;
   options.linear_solver_type = ceres::DENSE_SCHUR;
   options.trust_region_strategy_type = ceres::DOGLEG;
-  options.max_num_iterations = options_.max_iterations;
+  options.max_num_iterations = max_iterations;
   options.num_threads = options_.num_threads;
   ceres::Solver::Summary summary;
   ceres::Solve(options, &problem, &summary);
   last_iterations_ = static_cast<int>(summary.iterations.size());
   parametersToStates();
   removeReprojectionOutliers();
+  if (options_.use_lines) {
+    removeLineOutliers();
+    lines_.updateExtents([this](int64_t ns) { return cameraPose(ns); });
+    updateLineUncertainty();
+  }
 }
 
 void Estimator::removeReprojectionOutliers() {
@@ -161,6 +201,14 @@ void Estimator::marginalize() {
       info->addResidualBlock(new MarginalizationFactor(last_marginalization_), nullptr,
                              last_marginalization_blocks_, drop);
     }
+    if (bias_prior_pending_) {
+      // The prior leaves the window with the oldest keyframe: into the marginalisation prior.
+      info->addResidualBlock(
+          new BiasPriorFactor(Eigen::Vector3d::Zero(), bias_prior_bg_,
+                              options_.init_accel_bias_sigma, options_.init_gyro_bias_sigma),
+          nullptr, {para_speed_bias_[0].data()}, {0});
+      bias_prior_pending_ = false;
+    }
     if (preintegrations_[1]->sumDt() < kMaxImuFactorSpan)
       info->addResidualBlock(new ImuFactor(preintegrations_[1].get(), gravity_), nullptr,
                              {para_pose_[0].data(), para_speed_bias_[0].data(),
@@ -178,6 +226,23 @@ void Estimator::marginalize() {
             new PointProjectionFactor(obs_i, l.sightings[k].xy1.head<2>(), T_b_c_, sqrt_info),
             makeLoss(options_),
             {para_pose_[0].data(), para_pose_[k].data(), &para_inv_depth_[index]}, {0, 2});
+    }
+    if (options_.use_lines) {
+      // Lines first seen in the oldest frame leave the state with it, like points anchored
+      // there: all their window observations go into the prior.
+      const double line_sqrt_info = camera_.intrinsics[0] / options_.line_sigma_px;
+      std::map<int64_t, int> slot;
+      for (int i = 0; i <= frame_count_; ++i) slot[header_ns_[i]] = i;
+      std::size_t k = 0;
+      for (const auto& [id, l] : lines_.landmarks()) {
+        if (!lines_.usable(l)) continue;
+        double* line_block = para_line_[k++].data();
+        if (l.observations.begin()->first != header_ns_[0]) continue;
+        for (const auto& [ns, obs] : l.observations)
+          info->addResidualBlock(
+              new LineProjectionFactor(obs.start_norm, obs.end_norm, T_b_c_, line_sqrt_info),
+              makeLoss(options_), {para_pose_[slot.at(ns)].data(), line_block}, {1});
+      }
     }
     if (!info->marginalize()) {
       last_marginalization_.reset();
@@ -219,6 +284,52 @@ void Estimator::marginalize() {
   shift[para_speed_bias_[W_ - 1].data()] = para_speed_bias_[W_ - 1].data();
   last_marginalization_blocks_ = info->keptBlocks(shift);
   last_marginalization_ = info;
+}
+
+void Estimator::removeLineOutliers() {
+  // Mean endpoint-to-line distance over the window, in pixels; lines that the observed
+  // endpoints' rays meet behind a camera go too.
+  const double f = camera_.intrinsics[0];
+  std::vector<int> outliers;
+  for (const auto& [id, l] : lines_.landmarks()) {
+    if (!lines_.usable(l)) continue;
+    double err = 0;
+    bool behind = false;
+    for (const auto& [ns, obs] : l.observations) {
+      const PluckerLine lc = l.line_w.transformed(cameraPose(ns).inverse());
+      const Eigen::Vector3d line = lc.normalisedImageLine();
+      const double norm = line.head<2>().norm();
+      if (norm < 1e-12) {
+        behind = true;
+        break;
+      }
+      for (const Eigen::Vector2d& e : {obs.start_norm, obs.end_norm}) {
+        err += 0.5 * std::abs(Eigen::Vector3d(e.x(), e.y(), 1).dot(line)) / norm * f;
+        double s_line = 0, t_ray = 0;
+        if (closestPointOnLineToRay(lc, Eigen::Vector3d::Zero(), Eigen::Vector3d(e.x(), e.y(), 1),
+                                    &s_line, &t_ray))
+          behind |= t_ray < options_.line_triangulation.min_depth;
+      }
+    }
+    if (behind || err / l.observations.size() > options_.line_outlier_px) outliers.push_back(id);
+  }
+  lines_.removeIds(outliers);
+}
+
+void Estimator::updateLineUncertainty() {
+  const double sigma = options_.line_sigma_px / camera_.intrinsics[0];
+  for (auto& [id, l] : lines_.landmarks()) {
+    if (!lines_.usable(l)) continue;
+    LineViews views;
+    for (const auto& [ns, obs] : l.observations) {
+      LineView v;
+      v.T_w_c = cameraPose(ns);
+      v.start_norm = obs.start_norm;
+      v.end_norm = obs.end_norm;
+      views.push_back(v);
+    }
+    l.direction_std_deg = LineLandmarks::directionStdDeg(l.line_w, views, sigma);
+  }
 }
 
 }  // namespace alvio

@@ -18,11 +18,19 @@ EstimatorOptions EstimatorOptions::load(const YamlReader& yaml, const std::strin
   o.outlier_reprojection_px =
       yaml.getDouble(p + "outlier_reprojection_px", o.outlier_reprojection_px);
   o.imu_noise_scale = yaml.getDouble(p + "imu_noise_scale", o.imu_noise_scale);
+  o.use_lines = yaml.getBool(p + "use_lines", o.use_lines);
+  o.line_sigma_px = yaml.getDouble(p + "line_sigma_px", o.line_sigma_px);
+  o.line_min_observations = yaml.getInt(p + "line_min_observations", o.line_min_observations);
+  o.line_outlier_px = yaml.getDouble(p + "line_outlier_px", o.line_outlier_px);
+  o.line_triangulation = LineTriangulationOptions::load(yaml, p + "line_triangulation");
   o.init_min_parallax_px = yaml.getDouble(p + "init_min_parallax_px", o.init_min_parallax_px);
   o.init_min_correspondences =
       yaml.getInt(p + "init_min_correspondences", o.init_min_correspondences);
   o.init_retry_interval_s = yaml.getDouble(p + "init_retry_interval_s", o.init_retry_interval_s);
-  o.min_tracked_points = yaml.getInt(p + "min_tracked_points", o.min_tracked_points);
+  o.init_max_accel_bias = yaml.getDouble(p + "init_max_accel_bias", o.init_max_accel_bias);
+  o.init_accel_bias_sigma = yaml.getDouble(p + "init_accel_bias_sigma", o.init_accel_bias_sigma);
+  o.init_gyro_bias_sigma = yaml.getDouble(p + "init_gyro_bias_sigma", o.init_gyro_bias_sigma);
+  o.min_tracked_features = yaml.getInt(p + "min_tracked_features", o.min_tracked_features);
   o.max_accel_bias = yaml.getDouble(p + "max_accel_bias", o.max_accel_bias);
   o.max_gyro_bias = yaml.getDouble(p + "max_gyro_bias", o.max_gyro_bias);
   o.max_translation_jump_m = yaml.getDouble(p + "max_translation_jump_m", o.max_translation_jump_m);
@@ -32,6 +40,9 @@ EstimatorOptions EstimatorOptions::load(const YamlReader& yaml, const std::strin
   if (o.max_iterations < 1) throw Error(yaml.where(p + "max_iterations") + " must be at least 1");
   if (o.num_threads < 1) throw Error(yaml.where(p + "num_threads") + " must be at least 1");
   if (o.point_sigma_px <= 0) throw Error(yaml.where(p + "point_sigma_px") + " must be positive");
+  if (o.line_sigma_px <= 0) throw Error(yaml.where(p + "line_sigma_px") + " must be positive");
+  if (o.line_min_observations < 2)
+    throw Error(yaml.where(p + "line_min_observations") + " must be at least 2");
   if (o.imu_noise_scale <= 0) throw Error(yaml.where(p + "imu_noise_scale") + " must be positive");
   if (o.robust_loss != "cauchy" && o.robust_loss != "huber" && o.robust_loss != "none")
     throw Error(yaml.where(p + "robust_loss") + ": unknown loss '" + o.robust_loss +

@@ -62,9 +62,18 @@ inline Eigen::Matrix4d quaternionRight(const Eigen::Quaterniond& q) {
   return m;
 }
 
-/// Yaw (about z) of a rotation, in radians, for z-y-x Euler angles.
+/// Yaw (about z) of a rotation, in radians, for z-y-x Euler angles. Ill-defined when the
+/// body x axis is near vertical (as on the EuRoC MAV): prefer yawAlignment() for differences.
 inline double yawOf(const Eigen::Matrix3d& R) {
   return std::atan2(R(1, 0), R(0, 0));
+}
+
+/// The rotation angle psi about z that best maps `R_source` onto `R_target`
+/// (minimises |Rz(psi) R_source - R_target|_F). Well defined for any body orientation,
+/// unlike a difference of Euler yaws.
+inline double yawAlignment(const Eigen::Matrix3d& R_target, const Eigen::Matrix3d& R_source) {
+  const Eigen::Matrix3d M = R_target * R_source.transpose();
+  return std::atan2(M(1, 0) - M(0, 1), M(0, 0) + M(1, 1));
 }
 
 /// Rotation R_w_x that maps the measured gravity direction `g_x` (pointing up, as an

@@ -22,6 +22,7 @@
 #include "alvio/common/types.h"
 #include "alvio/config/sensor_options.h"
 #include "alvio/estimator/estimator_options.h"
+#include "alvio/estimator/line_landmarks.h"
 #include "alvio/estimator/point_landmarks.h"
 #include "alvio/frontend/feature_frame.h"
 #include "alvio/imu/imu_preintegration.h"
@@ -42,6 +43,17 @@ struct BodyState {
   Eigen::Vector3d bg = Eigen::Vector3d::Zero();
   EIGEN_MAKE_ALIGNED_OPERATOR_NEW
 };
+
+/// A 3D line landmark of the window, in the output world frame.
+struct LineSegment3 {
+  int id = -1;
+  Eigen::Vector3d start = Eigen::Vector3d::Zero();
+  Eigen::Vector3d end = Eigen::Vector3d::Zero();
+  int observations = 0;           ///< in the window (0 for retired lines)
+  double direction_std_deg = -1;  ///< 1-sigma direction uncertainty
+  EIGEN_MAKE_ALIGNED_OPERATOR_NEW
+};
+using LineSegments3 = std::vector<LineSegment3, Eigen::aligned_allocator<LineSegment3>>;
 
 /// Something a user should know about: initialisation, a reset, why it waits.
 struct EstimatorEvent {
@@ -72,13 +84,21 @@ class Estimator {
   std::vector<BodyState, Eigen::aligned_allocator<BodyState>> windowStates() const;
   /// Triangulated landmarks in the output world frame, by id.
   std::map<int, Eigen::Vector3d> landmarkPositions() const;
+  /// Line landmarks used by the optimisation, with their observed extents (output frame).
+  /// With `max_direction_std_deg` > 0 only lines whose direction is that well constrained.
+  LineSegments3 lineSegments(double max_direction_std_deg = -1) const;
+  /// Lines that left the window since the last call, each refined over its whole track
+  /// with the final poses of every frame that saw it (for maps). Output frame.
+  LineSegments3 takeRetiredLines();
   int resetCount() const { return reset_count_; }
   /// Events since the last call (moved out).
   std::vector<EstimatorEvent> takeEvents();
   /// Residual blocks and iterations of the last optimisation (diagnostics).
   int lastIterations() const { return last_iterations_; }
   int lastPointResiduals() const { return last_point_residuals_; }
+  int lastLineResiduals() const { return last_line_residuals_; }
   const PointLandmarks& points() const { return points_; }
+  const LineLandmarks& lines() const { return lines_; }
 
  private:
   struct ImageFrame {
@@ -103,11 +123,14 @@ class Estimator {
   ImuNoise imuNoise() const;
 
   // estimator_optimization.cpp
-  void optimize(FrameTiming* timing);
+  void optimize(FrameTiming* timing, int max_iterations);
   void statesToParameters();
   void parametersToStates();
   void marginalize();
   void removeReprojectionOutliers();
+  void removeLineOutliers();
+  void updateLineUncertainty();
+  Eigen::Isometry3d cameraPose(int64_t frame_ns) const;  // T_w_c of a window frame
 
   // estimator_initialization.cpp
   bool initialize(double t);
@@ -127,17 +150,20 @@ class Estimator {
 
   // Window states, W_ + 1 slots.
   std::vector<double> headers_;
+  std::vector<int64_t> header_ns_;  // same, exact
   std::vector<Eigen::Vector3d> Ps_, Vs_, Bas_, Bgs_;
   std::vector<Eigen::Matrix3d> Rs_;
   std::vector<std::unique_ptr<ImuPreintegration>> preintegrations_;
   std::vector<std::vector<double>> dt_buf_;
   std::vector<std::vector<Eigen::Vector3d>> acc_buf_, gyr_buf_;
   PointLandmarks points_;
+  LineLandmarks lines_;
 
   // Ceres parameter blocks; addresses are stable for the estimator's lifetime.
   std::vector<std::array<double, 7>> para_pose_;
   std::vector<std::array<double, 9>> para_speed_bias_;
   std::vector<double> para_inv_depth_;
+  std::vector<std::array<double, 4>> para_line_;  // usable lines, in iteration order
 
   std::shared_ptr<MarginalizationInfo> last_marginalization_;
   std::vector<double*> last_marginalization_blocks_;
@@ -168,7 +194,9 @@ class Estimator {
   BodyState last_output_;
   int reset_count_ = 0;
   double init_scale_ = 0;
-  int last_iterations_ = 0, last_point_residuals_ = 0;
+  bool bias_prior_pending_ = false;  // the initialisation bias prior is not yet marginalised
+  Eigen::Vector3d bias_prior_bg_ = Eigen::Vector3d::Zero();
+  int last_iterations_ = 0, last_point_residuals_ = 0, last_line_residuals_ = 0;
   std::vector<EstimatorEvent> events_;
 };
 

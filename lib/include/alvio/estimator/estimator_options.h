@@ -3,6 +3,8 @@
 
 #include <string>
 
+#include "alvio/geometry/line_triangulation.h"
+
 namespace alvio {
 
 class YamlReader;
@@ -18,15 +20,25 @@ struct EstimatorOptions {
   double outlier_reprojection_px = 3.0;  ///< landmarks with a larger mean error are removed
   double imu_noise_scale = 1.0;          ///< multiplies every IMU noise density and random walk
 
+  // Lines.
+  bool use_lines = true;          ///< line landmarks in the optimisation
+  double line_sigma_px = 1.5;     ///< endpoint-to-line noise of line observations
+  int line_min_observations = 3;  ///< window observations before a line is used
+  double line_outlier_px = 5.0;   ///< lines with a larger mean endpoint error are removed
+  LineTriangulationOptions line_triangulation;
+
   // Initialisation.
   double init_min_parallax_px = 30;  ///< between the reference frame and the newest
   int init_min_correspondences = 20;
   double init_retry_interval_s = 0.1;
+  double init_accel_bias_sigma = 0.2;  ///< bias prior at initialisation [m/s^2] (<= 0: none)
+  double init_gyro_bias_sigma = 0.05;  ///< [rad/s]
+  double init_max_accel_bias = 0.5;    ///< reject an initialisation that needs a larger bias
 
   // Failure detection (reset and re-initialise).
-  int min_tracked_points = 10;  ///< fewer points tracked into a new frame (after init)
-  double max_accel_bias = 2.5;  ///< m/s^2
-  double max_gyro_bias = 1.0;   ///< rad/s
+  int min_tracked_features = 10;  ///< fewer points + lines tracked into a frame: reset
+  double max_accel_bias = 2.5;    ///< m/s^2
+  double max_gyro_bias = 1.0;     ///< rad/s
   double max_translation_jump_m = 5.0;
   double max_z_jump_m = 1.0;
   double max_rotation_jump_deg = 50.0;

@@ -38,6 +38,9 @@ struct LineLandmark {
   Eigen::Vector3d start_w = Eigen::Vector3d::Zero();
   Eigen::Vector3d end_w = Eigen::Vector3d::Zero();
   bool has_extent = false;
+  /// 1-sigma uncertainty of the line's direction from its window observations [deg]
+  /// (negative until computed). Lines seen with little parallax are poorly constrained.
+  double direction_std_deg = -1;
 
   bool hasLine() const { return status != LineLandmarkStatus::kNew; }
   /// Set a new line (after triangulation or optimisation); the old extent is projected

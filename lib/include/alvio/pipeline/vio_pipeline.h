@@ -12,6 +12,7 @@
 #include "alvio/config/config.h"
 #include "alvio/estimator/estimator.h"
 #include "alvio/frontend/point_tracker.h"
+#include "alvio/lines/line_tracker.h"
 
 namespace alvio {
 
@@ -40,6 +41,7 @@ class VioPipeline {
   Config config_;
   std::shared_ptr<const CameraModel> camera_;
   PointTracker point_tracker_;
+  std::unique_ptr<LineTracker> line_tracker_;  // null when lines are off
   Estimator estimator_;
 };
 

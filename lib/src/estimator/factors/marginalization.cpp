@@ -36,7 +36,13 @@ Eigen::VectorXd tangentDifference(const double* x, const double* x0, int size) {
     for (int i = 0; i < size; ++i) d[i] = x[i] - x0[i];
     return d;
   }
-  PoseManifold().Minus(x, x0, d.data());
+  // q and -q are the same rotation: take the difference along the shorter path, or a sign
+  // flip of the parameter (from a matrix-to-quaternion conversion) reads as a 360 deg turn.
+  double y[7];
+  std::copy(x, x + 7, y);
+  if (Eigen::Map<const Eigen::Vector4d>(x + 3).dot(Eigen::Map<const Eigen::Vector4d>(x0 + 3)) < 0)
+    for (int i = 3; i < 7; ++i) y[i] = -y[i];
+  PoseManifold().Minus(y, x0, d.data());
   return d;
 }
 

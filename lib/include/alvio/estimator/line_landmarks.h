@@ -1,0 +1,72 @@
+#pragma once
+// Line landmarks of the sliding window: segment observations per window frame
+// (keyed by the frame's time in ns, so dropping any frame is one erase), their
+// triangulation from the window poses, and the observed extent for maps.
+// Lines live in the world frame (not anchored to a keyframe), so removing a
+// frame never re-parameterises them.
+
+#include <functional>
+#include <map>
+#include <vector>
+
+#include "alvio/frontend/feature_frame.h"
+#include "alvio/geometry/line_landmark.h"
+#include "alvio/geometry/line_triangulation.h"
+
+namespace alvio {
+
+class LineLandmarks {
+ public:
+  /// `min_observations`: window observations a line needs before it is triangulated and used.
+  LineLandmarks(int min_observations, const LineTriangulationOptions& triangulation)
+      : min_observations_(min_observations), triangulation_(triangulation) {}
+
+  void addFrame(
+      int64_t frame_ns,
+      const std::vector<LineObservation, Eigen::aligned_allocator<LineObservation>>& lines);
+  /// A frame leaves the window: its observations move to the lines' history with the frame's
+  /// final camera pose T_w_c. A line left with no window observation retires: it is refined
+  /// over its whole history (all its observations, poses fixed) and queued for takeRetired().
+  void removeFrame(int64_t frame_ns, const Eigen::Isometry3d& T_w_c);
+
+  /// Triangulate every untriangulated line with enough observations. `camera_pose(ns)`
+  /// gives T_w_c of a window frame.
+  void triangulate(const std::function<Eigen::Isometry3d(int64_t)>& camera_pose);
+  /// Recompute the extents of usable lines from their observations.
+  void updateExtents(const std::function<Eigen::Isometry3d(int64_t)>& camera_pose);
+
+  /// In the optimisation: triangulated, not an outlier, enough observations.
+  bool usable(const LineLandmark& l) const {
+    return l.hasLine() && l.status != LineLandmarkStatus::kOutlier &&
+           static_cast<int>(l.observations.size()) >= min_observations_;
+  }
+  int usableCount() const;
+  void removeIds(const std::vector<int>& ids);
+  /// Lines of the last frame that continued an existing track.
+  int lastTrackedCount() const { return last_tracked_; }
+  void clear() {
+    landmarks_.clear();
+    history_.clear();
+  }
+  /// Lines retired since the last call, refined over their whole track (world frame).
+  std::vector<LineLandmark> takeRetired();
+  /// Direction uncertainty [deg] of a line from views (residual noise sigma in normalised units).
+  static double directionStdDeg(const PluckerLine& line, const LineViews& views, double sigma);
+  void setObservationSigma(double sigma_normalised) { sigma_ = sigma_normalised; }
+
+  std::map<int, LineLandmark>& landmarks() { return landmarks_; }
+  const std::map<int, LineLandmark>& landmarks() const { return landmarks_; }
+
+ private:
+  bool usableForRetirement(const LineLandmark& l, const LineViews& views) const;
+
+  int min_observations_;
+  LineTriangulationOptions triangulation_;
+  int last_tracked_ = 0;
+  std::map<int, LineLandmark> landmarks_;  // by id: deterministic order
+  std::map<int, LineViews> history_;       // observations of frames that left the window
+  std::vector<LineLandmark> retired_;
+  double sigma_ = 1.5 / 458.0;
+};
+
+}  // namespace alvio

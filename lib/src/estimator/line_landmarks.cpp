@@ -1,0 +1,157 @@
+#include "alvio/estimator/line_landmarks.h"
+
+#include <Eigen/LU>
+#include <cmath>
+
+#include "alvio/geometry/line_projection_factor.h"
+#include "alvio/geometry/orthonormal_line.h"
+#include "alvio/geometry/orthonormal_line_manifold.h"
+
+namespace alvio {
+
+void LineLandmarks::addFrame(
+    int64_t frame_ns,
+    const std::vector<LineObservation, Eigen::aligned_allocator<LineObservation>>& lines) {
+  last_tracked_ = 0;
+  for (const auto& o : lines) {
+    LineLandmarkObservation obs;
+    obs.start_norm = o.start_norm;
+    obs.end_norm = o.end_norm;
+    auto [it, inserted] = landmarks_.try_emplace(o.id);
+    if (inserted)
+      it->second.id = o.id;
+    else
+      ++last_tracked_;
+    it->second.observations[frame_ns] = obs;
+  }
+}
+
+void LineLandmarks::removeFrame(int64_t frame_ns, const Eigen::Isometry3d& T_w_c) {
+  for (auto it = landmarks_.begin(); it != landmarks_.end();) {
+    LineLandmark& l = it->second;
+    const auto obs = l.observations.find(frame_ns);
+    if (obs != l.observations.end()) {
+      LineView v;
+      v.T_w_c = T_w_c;
+      v.start_norm = obs->second.start_norm;
+      v.end_norm = obs->second.end_norm;
+      history_[l.id].push_back(v);
+      l.observations.erase(obs);
+    }
+    if (!l.observations.empty()) {
+      ++it;
+      continue;
+    }
+    // Retire: one refinement over every observation of the track, for the map.
+    const LineViews& views = history_[l.id];
+    if (usableForRetirement(l, views)) {
+      PluckerLine line = l.line_w;
+      if (refineLine(views, triangulation_, &line)) {
+        LineLandmark retired = l;
+        retired.setLine(line, LineLandmarkStatus::kOptimised);
+        retired.has_extent = false;
+        Eigen::Vector3d a, b;
+        if (lineExtent(line, views, &a, &b)) {
+          retired.start_w = a;
+          retired.end_w = b;
+          retired.has_extent = true;
+          retired.direction_std_deg = directionStdDeg(line, views, sigma_);
+          retired_.push_back(retired);
+        }
+      }
+    }
+    history_.erase(l.id);
+    it = landmarks_.erase(it);
+  }
+}
+
+bool LineLandmarks::usableForRetirement(const LineLandmark& l, const LineViews& views) const {
+  return l.hasLine() && l.status != LineLandmarkStatus::kOutlier &&
+         static_cast<int>(views.size()) >= min_observations_;
+}
+
+std::vector<LineLandmark> LineLandmarks::takeRetired() {
+  std::vector<LineLandmark> out;
+  out.swap(retired_);
+  return out;
+}
+
+double LineLandmarks::directionStdDeg(const PluckerLine& line, const LineViews& views,
+                                      double sigma) {
+  // Information of the line from the views (poses fixed), whitened by sigma; the tangent
+  // components dtheta_x and dtheta_z of the orthonormal representation turn the direction.
+  double x[4];
+  OrthonormalLine::fromPlucker(line).toParameters(x);
+  Eigen::Matrix<double, 4, 4, Eigen::RowMajor> plus_jacobian;
+  OrthonormalLineManifold().PlusJacobian(x, plus_jacobian.data());
+  Eigen::Matrix4d H = Eigen::Matrix4d::Zero();
+  for (const auto& v : views) {
+    const LineProjectionFactor f(v.start_norm, v.end_norm, Eigen::Isometry3d::Identity(),
+                                 1.0 / sigma);
+    double pose[7];
+    poseToParameters(v.T_w_c, pose);
+    const double* params[] = {pose, x};
+    Eigen::Vector2d r;
+    Eigen::Matrix<double, 2, 4, Eigen::RowMajor> J;
+    double* jacobians[] = {nullptr, J.data()};
+    if (!f.Evaluate(params, r.data(), jacobians)) continue;
+    const Eigen::Matrix<double, 2, 4> Jt = J * plus_jacobian;
+    H += Jt.transpose() * Jt;
+  }
+  const Eigen::FullPivLU<Eigen::Matrix4d> lu(H);
+  if (!lu.isInvertible()) return 180.0;
+  const Eigen::Matrix4d C = lu.inverse();
+  return std::sqrt(std::max(0.0, C(0, 0) + C(2, 2))) * 180.0 / M_PI;
+}
+
+namespace {
+LineViews viewsOf(const LineLandmark& l,
+                  const std::function<Eigen::Isometry3d(int64_t)>& camera_pose) {
+  LineViews views;
+  for (const auto& [ns, obs] : l.observations) {
+    LineView v;
+    v.T_w_c = camera_pose(ns);
+    v.start_norm = obs.start_norm;
+    v.end_norm = obs.end_norm;
+    views.push_back(v);
+  }
+  return views;
+}
+}  // namespace
+
+void LineLandmarks::triangulate(const std::function<Eigen::Isometry3d(int64_t)>& camera_pose) {
+  for (auto& [id, l] : landmarks_) {
+    if (l.hasLine() || static_cast<int>(l.observations.size()) < min_observations_) continue;
+    PluckerLine line;
+    if (triangulateLineMultiView(viewsOf(l, camera_pose), triangulation_, &line) !=
+        LineTriangulationStatus::kOk)
+      continue;  // degenerate for now; more motion may make it observable
+    l.setLine(line, LineLandmarkStatus::kTriangulated);
+    Eigen::Vector3d a, b;
+    if (lineExtent(line, viewsOf(l, camera_pose), &a, &b)) {
+      l.start_w = a;
+      l.end_w = b;
+      l.has_extent = true;
+    }
+  }
+}
+
+void LineLandmarks::updateExtents(const std::function<Eigen::Isometry3d(int64_t)>& camera_pose) {
+  for (auto& [id, l] : landmarks_) {
+    if (!usable(l)) continue;
+    Eigen::Vector3d a, b;
+    if (lineExtent(l.line_w, viewsOf(l, camera_pose), &a, &b)) l.unionExtent(a, b);
+  }
+}
+
+int LineLandmarks::usableCount() const {
+  int n = 0;
+  for (const auto& [id, l] : landmarks_) n += usable(l);
+  return n;
+}
+
+void LineLandmarks::removeIds(const std::vector<int>& ids) {
+  for (int id : ids) landmarks_.erase(id);
+}
+
+}  // namespace alvio
