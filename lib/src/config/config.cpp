@@ -16,6 +16,7 @@ Config Config::load(const std::string& path) {
   c.topics = TopicOptions::load(yaml, "topics");
   c.points = PointTrackerOptions::load(yaml, "points");
   c.estimator = EstimatorOptions::load(yaml, "estimator");
+  c.logger = LoggerOptions::load(yaml, "logger");
   yaml.warnUnknownKeys();
   return c;
 }

@@ -4,6 +4,7 @@
 
 #include <string>
 
+#include "alvio/config/logger_options.h"
 #include "alvio/config/sensor_options.h"
 #include "alvio/estimator/estimator_options.h"
 #include "alvio/frontend/point_tracker.h"
@@ -17,6 +18,7 @@ struct Config {
   TopicOptions topics;
   PointTrackerOptions points;
   EstimatorOptions estimator;
+  LoggerOptions logger;
 
   /// Load and validate `path`. Missing/malformed keys throw alvio::Error naming
   /// file and key; unknown keys are logged as warnings.
