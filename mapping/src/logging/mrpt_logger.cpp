@@ -20,6 +20,7 @@
 #include <mrpt/system/datetime.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -27,6 +28,7 @@
 #include <iomanip>
 #include <limits>
 #include <map>
+#include <mutex>
 #include <sstream>
 
 #include "alvio/common/error.h"
@@ -148,7 +150,7 @@ struct MrptLogger::Impl {
   CameraOptions camera;
   LoggerPaths paths;
   LoggerCounts counts;
-  bool finished = false;
+  std::atomic<bool> finished{false};
 
   // Rawlog: observations wait in time order until nothing older can come.
   mrpt::io::CFileGZOutputStream rawlog_stream;
@@ -166,6 +168,7 @@ struct MrptLogger::Impl {
   // Text log.
   mrpt::system::COutputLogger text{"alvio"};
   std::ofstream text_out;
+  std::mutex text_mutex;  // log() may come from the core's log sink on any thread
 
   // Throughput: the frames since the last stats line.
   struct Period {
@@ -197,6 +200,7 @@ struct MrptLogger::Impl {
     text.setMinLoggingLevel(toMrptLevel(options.textLevel()));
     text.logRegisterCallback([this](std::string_view msg, mrpt::system::VerbosityLevel level,
                                     std::string_view /*logger*/, mrpt::Clock::time_point stamp) {
+      std::lock_guard<std::mutex> lock(text_mutex);
       text_out << mrpt::system::dateTimeLocalToString(stamp) << " [" << levelTag(level) << "] "
                << msg;
       if (msg.empty() || msg.back() != '\n') text_out << '\n';
@@ -494,6 +498,13 @@ void MrptLogger::addFrameStats(const FrameStats& s) {
   }
 }
 
+void MrptLogger::flushStats() {
+  Impl& d = *impl_;
+  if (d.finished || !d.options.text_log || d.period.frames == 0) return;
+  d.writeStats();
+  d.resetPeriod(d.period.last_t);
+}
+
 bool MrptLogger::sceneDue(double t) const {
   const Impl& d = *impl_;
   if (d.finished || !d.options.scenes || d.options.scene_period_s <= 0) return false;
@@ -525,7 +536,7 @@ void MrptLogger::finish(const MapSnapshot* final_map) {
     const double t = d.estimated.empty() ? 0.0 : d.estimated.back().t;
     writeScene(t, *final_map);
   }
-  if (d.options.text_log && d.period.frames > 0) d.writeStats();
+  flushStats();
   if (d.rawlog) {
     d.flushUpTo(std::numeric_limits<int64_t>::max());
     d.rawlog.reset();
@@ -537,7 +548,7 @@ void MrptLogger::finish(const MapSnapshot* final_map) {
        << d.counts.poses << " poses, " << d.counts.ground_truth << " ground-truth poses, "
        << d.counts.scenes << " scenes";
     d.text.logStr(mrpt::system::LVL_INFO, os.str());
-    d.text_out.flush();
+    std::lock_guard<std::mutex> lock(d.text_mutex);
     d.text_out.close();
   }
   d.finished = true;

@@ -141,6 +141,7 @@ void RunLogger::onFrame(const FrameView& frame) {
 
 void RunLogger::onFinish(const RunResult& result) {
   if (!logger_) return;
+  logger_->flushStats();
   std::ostringstream os;
   os << "run finished: " << result.frames << " frames, " << result.poses << " poses, "
      << result.resets << " resets, " << result.skipped_images << " skipped images";

@@ -8,6 +8,9 @@
 // Data may arrive slightly out of time order (frames are logged when the
 // pipeline is done with them, after later IMU samples): the rawlog is written
 // in time order through a short reorder buffer.
+//
+// Threads: log() may be called from any thread; everything else from one thread
+// at a time (the offline runner's, or a nodelet's serialised callbacks).
 
 #include <Eigen/Core>
 #include <cstdint>
@@ -88,6 +91,8 @@ class MrptLogger {
 
   /// One processed frame for the periodic throughput/feature-count line.
   void addFrameStats(const FrameStats& stats);
+  /// Write the throughput line of the frames since the last one now (end of a run).
+  void flushStats();
 
   /// Whether a scene snapshot is due at data time t (scene_period_s elapsed).
   bool sceneDue(double t) const;
