@@ -185,6 +185,12 @@ const std::string& renderedSequence() {
       gt.push_back(s);
     }
     writeEurocGroundTruthCsv((mav0 / "state_groundtruth_estimate0" / "data.csv").string(), gt);
+    std::atexit([] {
+      std::error_code ec;  // the 5 MB sequence goes; the tests' scratch folders stay
+      fs::remove_all(fs::temp_directory_path() / ("alvio_test_" + std::to_string(::getpid())) /
+                         "rendered_euroc",
+                     ec);
+    });
     return dir.string();
   }();
   return root;
