@@ -8,6 +8,7 @@
 #include "alvio/common/error.h"
 #include "alvio/common/logging.h"
 #include "alvio/config/config.h"
+#include "alvio/logging/run_logger.h"
 #include "alvio/pipeline/offline_runner.h"
 #include "rosbag_source.h"
 
@@ -24,6 +25,7 @@ int main(int argc, char** argv) {
   args.flag("no-lines", "points only (no line front end, no line landmarks)");
   args.option("line-tracker", "flow (ALVIO optical flow) | descriptor (PL-VIO LBD baseline)");
   args.flag("quiet", "no progress bar");
+  args.flag("no-log", "no MRPT logs (rawlog, 3D scene, alvio.log); also config logger.enabled");
   try {
     if (!args.parse(argc, argv)) return 0;
     Config config = Config::load(args.get("config"));
@@ -44,6 +46,11 @@ int main(int argc, char** argv) {
     options.out_dir = args.get("out");
     options.max_frames = args.getInt("max-frames");
     options.progress = !args.isSet("quiet");
+    std::unique_ptr<RunLogger> logger;
+    if (config.logger.enabled && !args.isSet("no-log")) {
+      logger = std::make_unique<RunLogger>(config.logger);
+      options.observers.push_back(logger.get());
+    }
     const RunResult r = runOffline(*source, config, options);
 
     std::cout << "frames: " << r.frames << ", poses: " << r.poses << ", resets: " << r.resets
@@ -56,6 +63,13 @@ int main(int argc, char** argv) {
     }
     std::cout << r.timing.summaryTable();
     std::cout << "outputs in " << options.out_dir << "\n";
+    if (logger && logger->logger()) {
+      const LoggerPaths& p = logger->logger()->paths();
+      std::cout << "MRPT logs:";
+      for (const std::string* f : {&p.rawlog, &p.scene, &p.text})
+        if (!f->empty()) std::cout << " " << *f;
+      std::cout << " (logger " << r.observer_ms << " ms)\n";
+    }
     if (r.evaluation) std::cout << "ATE_RMSE=" << r.evaluation->ate_translation_m.rmse << "\n";
     return r.poses > 0 ? 0 : 3;
   } catch (const Error& e) {

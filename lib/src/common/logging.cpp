@@ -30,6 +30,15 @@ void setLogSink(LogSink sink) {
   g_sink = std::move(sink);
 }
 
+LogSink logSink() {
+  std::lock_guard<std::mutex> lock(g_sink_mutex);
+  return g_sink;
+}
+
+void logToStderr(LogLevel level, const std::string& message) {
+  std::cerr << "[alvio " << logLevelName(level) << "] " << message << std::endl;
+}
+
 void setLogLevel(LogLevel level) {
   g_level = static_cast<int>(level);
 }
@@ -44,7 +53,7 @@ void logMessage(LogLevel level, const std::string& message) {
     g_sink(level, message);
     return;
   }
-  std::cerr << "[alvio " << logLevelName(level) << "] " << message << std::endl;
+  logToStderr(level, message);
 }
 
 }  // namespace alvio

@@ -17,6 +17,7 @@ Config Config::load(const std::string& path) {
   c.points = PointTrackerOptions::load(yaml, "points");
   c.estimator = EstimatorOptions::load(yaml, "estimator");
   c.lines = LineTrackerOptions::load(yaml, "lines");
+  c.logger = LoggerOptions::load(yaml, "logger");
   yaml.warnUnknownKeys();
   return c;
 }

@@ -1,5 +1,6 @@
 #include "alvio/pipeline/offline_runner.h"
 
+#include <chrono>
 #include <deque>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -90,6 +91,17 @@ RunResult runOffline(SensorSource& source, const Config& config, const RunOption
                                 : source.imageCount();
   ProgressBar progress("alvio run", total, options.progress);
 
+  // Observers' time is kept out of the pipeline's timing.
+  auto notify = [&](auto&& call) {
+    if (options.observers.empty()) return;
+    const auto start = std::chrono::steady_clock::now();
+    for (RunObserver* o : options.observers) call(*o);
+    result.observer_ms +=
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  };
+  const RunInfo info{config, source.description(), options.out_dir, gt ? &*gt : nullptr};
+  notify([&](RunObserver& o) { o.onStart(info); });
+
   // An image waits until an IMU sample after it has arrived, so the estimator can
   // interpolate the IMU at the image time.
   std::deque<SensorMessage> pending;
@@ -119,6 +131,7 @@ RunResult runOffline(SensorSource& source, const Config& config, const RunOption
       p.q = out.state.q;
       result.trajectory.push_back(p);
     }
+    notify([&](RunObserver& o) { o.onFrame(FrameView{m.t_ns, image, out, pipeline}); });
     progress.update(result.frames + result.skipped_images,
                     out.has_pose ? "tracking" : "initialising");
   };
@@ -128,6 +141,7 @@ RunResult runOffline(SensorSource& source, const Config& config, const RunOption
   while (source.next(&m)) {
     if (m.kind == SensorMessage::Kind::kImu) {
       pipeline.addImu(m.imu);
+      notify([&](RunObserver& o) { o.onImu(m.imu); });
       while (!pending.empty() && pending.front().t_ns < m.t_ns) {
         processImage(pending.front());
         pending.pop_front();
@@ -179,6 +193,7 @@ RunResult runOffline(SensorSource& source, const Config& config, const RunOption
   }
   writeFileAtomically((fs::path(options.out_dir) / "summary.json").string(),
                       summary.dump(2) + "\n");
+  notify([&](RunObserver& o) { o.onFinish(result); });
   return result;
 }
 

@@ -15,6 +15,10 @@ using LogSink = std::function<void(LogLevel, const std::string&)>;
 
 /// Replace the sink (thread-safe). Pass nullptr to restore the stderr sink.
 void setLogSink(LogSink sink);
+/// The current sink (empty when it is the stderr sink), so a tee can chain to it.
+LogSink logSink();
+/// What the default sink does: "[alvio <level>] message" on stderr.
+void logToStderr(LogLevel level, const std::string& message);
 /// Messages below this level are dropped before formatting reaches the sink.
 void setLogLevel(LogLevel level);
 LogLevel logLevel();

@@ -4,6 +4,7 @@
 
 #include <string>
 
+#include "alvio/config/logger_options.h"
 #include "alvio/config/sensor_options.h"
 #include "alvio/estimator/estimator_options.h"
 #include "alvio/frontend/point_tracker.h"
@@ -19,6 +20,7 @@ struct Config {
   PointTrackerOptions points;
   EstimatorOptions estimator;
   LineTrackerOptions lines;
+  LoggerOptions logger;
 
   /// Load and validate `path`. Missing/malformed keys throw alvio::Error naming
   /// file and key; unknown keys are logged as warnings.

@@ -9,11 +9,13 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "alvio/common/timing.h"
 #include "alvio/config/config.h"
 #include "alvio/estimator/estimator.h"
 #include "alvio/eval/trajectory_evaluation.h"
+#include "alvio/pipeline/run_observer.h"
 #include "alvio/pipeline/sensor_source.h"
 
 namespace alvio {
@@ -22,6 +24,8 @@ struct RunOptions {
   std::string out_dir;
   bool progress = true;
   int max_frames = -1;  ///< stop after this many images (-1: all)
+  /// Called with the run's data (not owned; e.g. the MRPT logger). See run_observer.h.
+  std::vector<RunObserver*> observers;
 };
 
 struct InitializationQuality {
@@ -38,6 +42,7 @@ struct RunResult {
   TimingLog timing;
   std::optional<InitializationQuality> initialization;
   std::optional<EvaluationResult> evaluation;  ///< SE(3) ATE, when ground truth exists
+  double observer_ms = 0;  ///< wall time spent in observers' onStart/onImu/onFrame
 };
 
 RunResult runOffline(SensorSource& source, const Config& config, const RunOptions& options);
