@@ -1,5 +1,6 @@
 // alvio_run: the offline runner. Reads an EuRoC folder or a rosbag, runs the
-// whole pipeline on every frame and writes the trajectory and timing.
+// whole pipeline on every frame and writes the trajectory and timing, and the map
+// (octomap.bt, lines.ply, lines.csv, map.3Dscene) unless mapping.enabled is false.
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -8,7 +9,11 @@
 #include "alvio/common/error.h"
 #include "alvio/common/logging.h"
 #include "alvio/config/config.h"
+#include "alvio/config/yaml_reader.h"
+#include "alvio/mapping/estimator_keyframe_feed.h"
+#include "alvio/mapping/map_builder.h"
 #include "alvio/pipeline/offline_runner.h"
+#include "alvio/pipeline/vio_pipeline.h"
 #include "rosbag_source.h"
 
 using namespace alvio;
@@ -35,7 +40,26 @@ int main(int argc, char** argv) {
     options.out_dir = args.get("out");
     options.max_frames = args.getInt("max-frames");
     options.progress = !args.isSet("quiet");
+
+    // The map: keyframe landmarks from the estimator's window, body poses for the scene.
+    const MappingOptions mapping = MappingOptions::load(YamlReader(args.get("config")), "mapping");
+    std::unique_ptr<MapBuilder> map;
+    EstimatorKeyframeFeed feed(config.camera.T_b_c);
+    if (mapping.enabled) {
+      map = std::make_unique<MapBuilder>(mapping);
+      options.on_frame = [&](const PipelineOutput& out, const Estimator& estimator) {
+        if (out.has_pose) map->addTrajectoryPose({out.state.t, out.state.p, out.state.q});
+        if (auto keyframe = feed.poll(estimator)) map->addKeyframe(*keyframe);
+      };
+      options.on_finish = [&](const Estimator& estimator) {
+        for (const KeyframeLandmarks& keyframe : feed.flush(estimator)) map->addKeyframe(keyframe);
+      };
+    }
     const RunResult r = runOffline(*source, config, options);
+    if (map) {
+      map->save(options.out_dir);
+      std::cout << "map:\n" << map->summary().toString();
+    }
 
     std::cout << "frames: " << r.frames << ", poses: " << r.poses << ", resets: " << r.resets
               << ", skipped images: " << r.skipped_images << "\n";

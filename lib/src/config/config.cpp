@@ -16,6 +16,7 @@ Config Config::load(const std::string& path) {
   c.topics = TopicOptions::load(yaml, "topics");
   c.points = PointTrackerOptions::load(yaml, "points");
   c.estimator = EstimatorOptions::load(yaml, "estimator");
+  yaml.markKnown("mapping");  // read by alvio_mapping (MappingOptions::load)
   yaml.warnUnknownKeys();
   return c;
 }

@@ -119,6 +119,7 @@ RunResult runOffline(SensorSource& source, const Config& config, const RunOption
       p.q = out.state.q;
       result.trajectory.push_back(p);
     }
+    if (options.on_frame) options.on_frame(out, pipeline.estimator());
     progress.update(result.frames + result.skipped_images,
                     out.has_pose ? "tracking" : "initialising");
   };
@@ -141,6 +142,7 @@ RunResult runOffline(SensorSource& source, const Config& config, const RunOption
   }
   for (const auto& p : pending) processImage(p);
   progress.finish();
+  if (options.on_finish) options.on_finish(pipeline.estimator());
   result.resets = pipeline.estimator().resetCount();
   result.poses = result.trajectory.size();
 

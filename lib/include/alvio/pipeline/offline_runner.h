@@ -7,6 +7,7 @@
 //   summary.json     counts, timing summary, initialisation quality and ATE
 // and, when the dataset has ground truth, prints the ATE.
 
+#include <functional>
 #include <optional>
 #include <string>
 
@@ -18,10 +19,16 @@
 
 namespace alvio {
 
+struct PipelineOutput;
+
 struct RunOptions {
   std::string out_dir;
   bool progress = true;
   int max_frames = -1;  ///< stop after this many images (-1: all)
+  /// Optional observers (e.g. the map builder of alvio_run): called after every processed
+  /// image, and once after the last one, with the estimator in its final state.
+  std::function<void(const PipelineOutput&, const Estimator&)> on_frame;
+  std::function<void(const Estimator&)> on_finish;
 };
 
 struct InitializationQuality {
