@@ -18,6 +18,8 @@ LineMapOptions LineMapOptions::load(const YamlReader& yaml, const std::string& p
   o.merge_min_overlap_m = yaml.getDouble(p + "merge_min_overlap_m", o.merge_min_overlap_m);
   o.index_cell_m = yaml.getDouble(p + "index_cell_m", o.index_cell_m);
   o.max_members_per_line = yaml.getInt(p + "max_members_per_line", o.max_members_per_line);
+  o.prune_weak_after_keyframes =
+      yaml.getInt(p + "prune_weak_after_keyframes", o.prune_weak_after_keyframes);
   o.min_observations = yaml.getInt(p + "min_observations", o.min_observations);
   o.min_length_m = yaml.getDouble(p + "min_length_m", o.min_length_m);
   o.max_length_m = yaml.getDouble(p + "max_length_m", o.max_length_m);
@@ -31,6 +33,7 @@ LineMapOptions LineMapOptions::load(const YamlReader& yaml, const std::string& p
   check(o.merge_min_overlap_m >= 0, "merge_min_overlap_m", "must be >= 0");
   check(o.index_cell_m > 0, "index_cell_m", "must be > 0");
   check(o.max_members_per_line >= 2, "max_members_per_line", "must be at least 2");
+  check(o.prune_weak_after_keyframes >= 0, "prune_weak_after_keyframes", "must be >= 0");
   check(o.min_length_m >= 0, "min_length_m", "must be >= 0");
   check(o.max_length_m > o.min_length_m, "max_length_m", "must be greater than min_length_m");
   return o;
@@ -52,7 +55,7 @@ bool LineMap::addSegment(int id, const Eigen::Vector3d& p0_w, const Eigen::Vecto
                                      : std::numeric_limits<double>::infinity();
   m.stamp = ++stamp_;
 
-  int key = -1;
+  int key = -1, home = -1;
   auto known = line_of_id_.find(id);
   if (known != line_of_id_.end()) {
     Line& line = lines_.at(known->second);
@@ -78,17 +81,18 @@ bool LineMap::addSegment(int id, const Eigen::Vector3d& p0_w, const Eigen::Vecto
         fit(&line);
         registerCells(key);
       } else {
-        const int old_key = known->second;
-        unregisterCells(old_key);
+        home = known->second;
+        unregisterCells(home);
         line.members.erase(old);
         fit(&line);
-        registerCells(old_key);
+        registerCells(home);
       }
     }
   }
   if (key < 0) key = newLine(m);
-  key = mergeNeighbours(key);
+  key = mergeNeighbours(key, home);
   Line& line = lines_.at(key);
+  line.last_keyframe = keyframe_;
   if (static_cast<int>(line.members.size()) > options_.max_members_per_line) {
     unregisterCells(key);
     foldOldMembers(&line);
@@ -97,10 +101,29 @@ bool LineMap::addSegment(int id, const Eigen::Vector3d& p0_w, const Eigen::Vecto
   return true;
 }
 
+std::size_t LineMap::beginKeyframe() {
+  ++keyframe_;
+  const int after = options_.prune_weak_after_keyframes;
+  if (after <= 0 || keyframe_ % 10 != 0) return 0;
+  std::vector<int> stale;
+  for (const auto& [key, line] : lines_)
+    if (line.observations < options_.min_observations && keyframe_ - line.last_keyframe > after)
+      stale.push_back(key);
+  for (int key : stale) {
+    unregisterCells(key);
+    for (const Member& m : lines_.at(key).members)
+      if (m.id >= 0) line_of_id_.erase(m.id);
+    lines_.erase(key);
+  }
+  pruned_ += stale.size();
+  return stale.size();
+}
+
 int LineMap::newLine(Member member) {
   const int key = next_key_++;
   Line& line = lines_[key];
   line.id = key;
+  line.last_keyframe = keyframe_;
   line.members.push_back(std::move(member));
   line_of_id_[line.members.front().id] = key;
   fit(&line);
@@ -178,10 +201,16 @@ void LineMap::foldOldMembers(Line* line) {
 }
 
 bool LineMap::compatible(const Line& a, const Line& b) const {
-  if (std::abs(a.u.dot(b.u)) < cos_merge_angle_) return false;
   const bool a_longer = a.t1 - a.t0 >= b.t1 - b.t0;
   const Line& lo = a_longer ? a : b;
   const Line& sh = a_longer ? b : a;
+  // The shorter segment's direction is known to about (2 x merge distance) / length.
+  const double short_len = sh.t1 - sh.t0;
+  const double cos_tol =
+      short_len > 0 ? std::min(cos_merge_angle_,
+                               std::cos(std::atan2(2 * options_.merge_distance_m, short_len)))
+                    : cos_merge_angle_;
+  if (std::abs(a.u.dot(b.u)) < cos_tol) return false;
   const Eigen::Vector3d s0 = sh.p0(), s1 = sh.p1();
   if (pointLineDistance(s0, lo.c, lo.u) > options_.merge_distance_m ||
       pointLineDistance(s1, lo.c, lo.u) > options_.merge_distance_m)
@@ -191,7 +220,7 @@ bool LineMap::compatible(const Line& a, const Line& b) const {
   return overlap >= options_.merge_min_overlap_m;
 }
 
-int LineMap::mergeNeighbours(int key) {
+int LineMap::mergeNeighbours(int key, int home) {
   for (;;) {
     const Line& line = lines_.at(key);
     if (line.t1 - line.t0 > options_.max_length_m) return key;  // outlier: not indexed
@@ -214,6 +243,8 @@ int LineMap::mergeNeighbours(int key) {
     if (other < 0) return key;
     // The older line survives, so map line IDs stay stable.
     const int keep = std::min(key, other), drop = std::max(key, other);
+    if (other != home) ++merges_;
+    home = -1;
     unregisterCells(keep);
     unregisterCells(drop);
     Line& kept = lines_.at(keep);
@@ -222,10 +253,10 @@ int LineMap::mergeNeighbours(int key) {
       if (m.id >= 0) line_of_id_[m.id] = keep;
       kept.members.push_back(std::move(m));
     }
+    kept.last_keyframe = std::max(kept.last_keyframe, dropped.last_keyframe);
     lines_.erase(drop);
     fit(&kept);
     registerCells(keep);
-    ++merges_;
     key = keep;
   }
 }

@@ -46,6 +46,7 @@ MapBuilder::MapBuilder(const MappingOptions& options)
 
 void MapBuilder::addKeyframe(const KeyframeLandmarks& keyframe) {
   ++keyframes_;
+  lines_.beginKeyframe();
   const Eigen::Vector3d camera = keyframe.T_w_c.translation();
   for (const LandmarkPoint& p : keyframe.points)
     if (p.p_w.allFinite()) points_[p.id] = p.p_w;

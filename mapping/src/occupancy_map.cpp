@@ -20,6 +20,7 @@ OccupancyMapOptions OccupancyMapOptions::load(const YamlReader& yaml, const std:
   o.clamp_max = yaml.getDouble(p + "sensor_model_max", o.clamp_max);
   o.line_sample_step_m = yaml.getDouble(p + "line_sample_step_m", o.line_sample_step_m);
   o.carve_free_space = yaml.getBool(p + "carve_free_space", o.carve_free_space);
+  o.min_line_observations = yaml.getInt(p + "min_line_observations", o.min_line_observations);
   auto check = [&](bool ok, const std::string& key, const std::string& what) {
     if (!ok) throw Error(yaml.where(p + key) + " " + what);
   };
@@ -68,6 +69,7 @@ void OccupancyMap::insertKeyframe(const KeyframeLandmarks& keyframe) {
   for (const LandmarkPoint& p : keyframe.points) pts.push_back(p.p_w);
   for (const LandmarkSegment& l : keyframe.lines) {
     if (!l.p0_w.allFinite() || !l.p1_w.allFinite()) continue;
+    if (l.observations < options_.min_line_observations) continue;
     // A triangulation blow-up would otherwise turn into millions of samples.
     const double step = std::max(options_.lineStep(), (l.p1_w - l.p0_w).norm() / 20000.0);
     for (const Eigen::Vector3d& s : sampleSegment(l.p0_w, l.p1_w, step)) pts.push_back(s);

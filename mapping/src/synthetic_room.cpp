@@ -45,7 +45,7 @@ std::vector<Segment3> roomEdges(const Eigen::Vector3d& s) {
     const double at = (wall % 2 == 0) ? 0.0 : s[across];
     const double c = s[along] / 2, h = 0.2 * s[along];
     auto P = [&](double t, double z) {
-      Eigen::Vector3d p;
+      Eigen::Vector3d p = Eigen::Vector3d::Zero();
       p[along] = t;
       p[across] = at;
       p.z() = z;
@@ -92,8 +92,15 @@ SyntheticRoom makeSyntheticRoom(const SyntheticRoomOptions& o) {
   const double half_fov_tan = std::tan(o.fov_deg * M_PI / 360);
   const Eigen::Vector3d centre(o.size.x() / 2, o.size.y() / 2, std::min(1.5, o.size.z() / 2));
 
+  // A track's line estimate: the true edge with its ends displaced by fixed offsets (an
+  // estimator's error is consistent over the track), plus a small jitter per keyframe.
   struct Track {
     int id = -1, age = 0, observations = 0, last_keyframe = -10;
+    Eigen::Vector3d o0 = Eigen::Vector3d::Zero(), o1 = Eigen::Vector3d::Zero();
+  };
+  // (Explicit return types: an Eigen expression returned by `auto` would dangle.)
+  auto gauss3 = [&](double sigma) -> Eigen::Vector3d {
+    return Eigen::Vector3d(noise(rng), noise(rng), noise(rng)) * sigma;
   };
   std::vector<Track> tracks(room.edges.size());
   int next_line_id = 0, next_point_id = 0;
@@ -135,19 +142,25 @@ SyntheticRoom makeSyntheticRoom(const SyntheticRoomOptions& o) {
         tr.id = next_line_id++;
         tr.age = 0;
         tr.observations = 0;
+        tr.o0 = gauss3(o.endpoint_noise_m);
+        tr.o1 = gauss3(o.endpoint_noise_m);
       }
       ++tr.age;
       tr.observations += o.frames_per_keyframe;
       tr.last_keyframe = k;
       // The detector finds a random 70-100 % of the visible run.
-      Eigen::Vector3d a = samples[best_begin], b = samples[best_begin + best_len - 1];
-      const Eigen::Vector3d d = b - a;
-      const double s0 = 0.15 * uni(rng), s1 = 1 - 0.15 * uni(rng);
+      const double n = static_cast<double>(samples.size() - 1);
+      const double r0 = best_begin / n, r1 = (best_begin + best_len - 1) / n;
+      const double s0 = r0 + 0.15 * uni(rng) * (r1 - r0), s1 = r1 - 0.15 * uni(rng) * (r1 - r0);
+      auto estimate = [&](double r) -> Eigen::Vector3d {
+        return edge.p0 + r * (edge.p1 - edge.p0) + (1 - r) * tr.o0 + r * tr.o1 +
+               gauss3(o.endpoint_noise_m / 3);
+      };
       LandmarkSegment seg;
       seg.id = tr.id;
       seg.observations = tr.observations;
-      seg.p0_w = a + s0 * d + o.endpoint_noise_m * Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
-      seg.p1_w = a + s1 * d + o.endpoint_noise_m * Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
+      seg.p0_w = estimate(s0);
+      seg.p1_w = estimate(s1);
       kf.lines.push_back(seg);
     }
     // Outliers: short random segments inside the room, reported once.

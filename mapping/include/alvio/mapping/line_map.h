@@ -9,6 +9,9 @@
 //   within tolerance) and overlapping are merged into one map line. A map line is the
 //   length- and observation-weighted total-least-squares fit of its members' segments,
 //   its extent the union of their projections; its observation count is their sum.
+//   A short segment's direction is only known to about (2 x merge distance) / length:
+//   for it the angle test allows that much, and lying inside the merge-distance tube
+//   around the longer line decides.
 // - A uniform hash grid over the segments finds merge candidates, so adding a segment
 //   costs about the number of lines near it, not the size of the map.
 // - Nothing is deleted while mapping: lines seen too rarely or looking like outliers
@@ -37,6 +40,10 @@ struct LineMapOptions {
   /// one fixed member (their IDs are then forgotten), which bounds the memory of a
   /// line seen again and again.
   int max_members_per_line = 16;
+  /// Lines still under min_observations that no keyframe has updated for this many
+  /// keyframes are deleted while mapping (one-off outliers would otherwise pile up);
+  /// 0 keeps them until saving.
+  int prune_weak_after_keyframes = 30;
   // Filtering when the map is saved.
   int min_observations = 4;     ///< summed image observations of a kept line
   double min_length_m = 0.1;    ///< shorter lines are dropped
@@ -67,13 +74,19 @@ class LineMap {
   /// Degenerate or non-finite segments are ignored (returns false).
   bool addSegment(int id, const Eigen::Vector3d& p0_w, const Eigen::Vector3d& p1_w,
                   int observations, const Eigen::Vector3d& camera_w);
+  /// Start a new keyframe (the clock of prune_weak_after_keyframes); prunes stale weak
+  /// lines every few keyframes. Returns the number of lines deleted.
+  std::size_t beginKeyframe();
 
   /// Lines in the map (after merging), before filtering.
   std::size_t size() const { return lines_.size(); }
   /// Landmark IDs whose latest estimate is remembered.
   std::size_t landmarkCount() const { return line_of_id_.size(); }
-  /// How many times two lines were merged into one.
+  /// How many times two lines were merged into one (a landmark merging back into its own
+  /// line after an update does not count).
   std::size_t mergeCount() const { return merges_; }
+  /// Weak lines deleted while mapping (prune_weak_after_keyframes).
+  std::size_t prunedCount() const { return pruned_; }
   /// All lines, ordered by id.
   std::vector<MapLine> lines() const;
   /// The lines kept when saving: enough observations, plausible length and depth.
@@ -101,6 +114,7 @@ class LineMap {
     double t0 = 0, t1 = 0; ///< extent along u from c
     int observations = 0, landmarks = 0;
     double min_depth = 0;
+    int64_t last_keyframe = 0;   ///< keyframe of the last update
     std::vector<int64_t> cells;  ///< grid cells it is registered in
     Eigen::Vector3d p0() const { return c + t0 * u; }
     Eigen::Vector3d p1() const { return c + t1 * u; }
@@ -109,8 +123,9 @@ class LineMap {
   static void fit(Line* line);
   void foldOldMembers(Line* line);
   bool compatible(const Line& a, const Line& b) const;
-  /// Merge `key` with every compatible neighbour; returns the surviving key.
-  int mergeNeighbours(int key);
+  /// Merge `key` with every compatible neighbour; returns the surviving key. Merging into
+  /// `home` (the line a re-reported landmark came from) is not counted as a merge.
+  int mergeNeighbours(int key, int home = -1);
   void registerCells(int key);
   void unregisterCells(int key);
   int newLine(Member member);
@@ -125,7 +140,8 @@ class LineMap {
   std::unordered_map<int64_t, std::vector<int>> grid_;  // cell -> line keys
   int next_key_ = 0;
   uint64_t stamp_ = 0;
-  std::size_t merges_ = 0;
+  std::size_t merges_ = 0, pruned_ = 0;
+  int64_t keyframe_ = 0;
 };
 
 }  // namespace alvio

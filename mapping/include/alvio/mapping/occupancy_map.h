@@ -29,10 +29,13 @@ struct OccupancyMapOptions {
   double clamp_max = 0.97;   ///< `sensor_model/max`
   double line_sample_step_m = 0;  ///< spacing of samples along lines; 0 = resolution / 2
   bool carve_free_space = true;   ///< false: mark endpoints only, no ray casting
+  /// Lines reported with fewer image observations do not go into the tree (a one-off
+  /// outlier segment would mark a whole row of voxels).
+  int min_line_observations = 3;
 
   /// Read the keys under `prefix` ("mapping.octomap"): resolution, sensor_model_max_range,
   /// sensor_model_hit, sensor_model_miss, sensor_model_min, sensor_model_max,
-  /// line_sample_step_m, carve_free_space. Throws alvio::Error naming the key.
+  /// line_sample_step_m, carve_free_space, min_line_observations. Throws alvio::Error naming the key.
   static OccupancyMapOptions load(const YamlReader& yaml, const std::string& prefix);
   double lineStep() const { return line_sample_step_m > 0 ? line_sample_step_m : resolution / 2; }
 };
@@ -58,8 +61,8 @@ class OccupancyMap {
   /// Mark `points_w` occupied and, when carving, the voxels on the rays from `origin_w`
   /// to them free.
   void insert(const Eigen::Vector3d& origin_w, const std::vector<Eigen::Vector3d>& points_w);
-  /// Insert a keyframe: its points and its lines sampled every lineStep(), seen from the
-  /// keyframe's camera centre.
+  /// Insert a keyframe: its points and its lines (those with at least min_line_observations)
+  /// sampled every lineStep(), seen from the keyframe's camera centre.
   void insertKeyframe(const KeyframeLandmarks& keyframe);
 
   /// Occupancy probability of the voxel at `p_w`, or nullopt when unknown.
