@@ -58,8 +58,8 @@ int main(int argc, char** argv) {
       mo.lines.merge_distance_m = 0;
     }
     MapBuilder builder(mo);
-    std::cout << "room " << room.size.transpose() << " m, " << room.edges.size()
-              << " true edges, " << room.keyframes.size() << " keyframes\n";
+    std::cout << "room " << room.size.transpose() << " m, " << room.edges.size() << " true edges, "
+              << room.keyframes.size() << " keyframes\n";
     std::cout << " lap  segments  line_ids  lines  kept  merges  mem_lines_KiB  mem_octree_KiB"
                  "  ms/keyframe\n";
     std::size_t segments = 0;
@@ -95,13 +95,13 @@ int main(int argc, char** argv) {
     std::vector<Segment3> kept;
     for (const MapLine& l : builder.lineMap().filteredLines()) kept.push_back(l.segment());
     const LineMapEvaluation le = evaluateLineMap(kept, room.edges, 0.10, 3.0 * M_PI / 180);
-    std::cout << std::setprecision(1) << "line map (10 cm, 3 deg): precision "
-              << 100 * le.precision << " % of " << le.map_length_m << " m, recall "
-              << 100 * le.recall << " % of " << le.true_length_m << " m true edges\n";
+    std::cout << std::setprecision(1) << "line map (10 cm, 3 deg): precision " << 100 * le.precision
+              << " % of " << le.map_length_m << " m, recall " << 100 * le.recall << " % of "
+              << le.true_length_m << " m true edges\n";
     const double res = builder.occupancyMap().options().resolution;
     const OccupancyEvaluation oe = evaluateOccupancy(
-        builder.occupancyMap().tree(), [&](const Eigen::Vector3d& p) { return room.surfaceDistance(p); },
-        2 * res);
+        builder.occupancyMap().tree(),
+        [&](const Eigen::Vector3d& p) { return room.surfaceDistance(p); }, 2 * res);
     std::cout << "occupancy: " << 100 * oe.fraction << " % of " << oe.occupied_voxels
               << " occupied voxels within 2 voxels of a wall (mean " << std::setprecision(3)
               << oe.mean_distance_m << " m)\n";

@@ -2,6 +2,7 @@
 // nodelet): line count and length, voxel counts, extent, file sizes; optionally a
 // top-view PNG (free space grey, occupied voxels shaded by height, lines red, the
 // trajectory blue when trajectory.tum is there).
+#include <octomap/OcTree.h>
 #include <algorithm>
 #include <filesystem>
 #include <iomanip>
@@ -9,7 +10,6 @@
 #include <limits>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
-#include <octomap/OcTree.h>
 
 #include "alvio/common/arg_parser.h"
 #include "alvio/common/error.h"
@@ -53,13 +53,14 @@ void writeTopView(const std::string& path, int size_px, const octomap::OcTree* t
     // Occupied voxels, low ones first so the top of a column shows; darker = higher.
     std::vector<Eigen::Vector4d> occ;
     for (auto it = tree->begin_leafs(), end = tree->end_leafs(); it != end; ++it)
-      if (tree->isNodeOccupied(*it)) occ.emplace_back(it.getX(), it.getY(), it.getZ(), it.getSize());
+      if (tree->isNodeOccupied(*it))
+        occ.emplace_back(it.getX(), it.getY(), it.getZ(), it.getSize());
     std::sort(occ.begin(), occ.end(), [](const auto& a, const auto& b) { return a.z() < b.z(); });
     const double z0 = box.lo.z(), dz = std::max(1e-6, box.hi.z() - box.lo.z());
     for (const auto& v : occ) {
       const int g = static_cast<int>(170 - 150 * std::clamp((v.z() - z0) / dz, 0.0, 1.0));
-      fill(v.x(), v.y(), v.w() / 2, {static_cast<double>(g), static_cast<double>(g), 
-                                      static_cast<double>(g)});
+      fill(v.x(), v.y(), v.w() / 2,
+           {static_cast<double>(g), static_cast<double>(g), static_cast<double>(g)});
     }
   }
   for (std::size_t i = 1; i < trajectory.size(); ++i)
@@ -125,8 +126,8 @@ int main(int argc, char** argv) {
       std::cout << "trajectory: " << trajectory.size() << " poses\n";
     }
     if (box.valid())
-      std::cout << "extent: [" << box.lo.x() << ", " << box.lo.y() << ", " << box.lo.z()
-                << "] .. [" << box.hi.x() << ", " << box.hi.y() << ", " << box.hi.z() << "] m ("
+      std::cout << "extent: [" << box.lo.x() << ", " << box.lo.y() << ", " << box.lo.z() << "] .. ["
+                << box.hi.x() << ", " << box.hi.y() << ", " << box.hi.z() << "] m ("
                 << box.hi.x() - box.lo.x() << " x " << box.hi.y() - box.lo.y() << " x "
                 << box.hi.z() - box.lo.z() << ")\n";
     else

@@ -27,8 +27,7 @@ LineMapOptions LineMapOptions::load(const YamlReader& yaml, const std::string& p
   auto check = [&](bool ok, const std::string& key, const std::string& what) {
     if (!ok) throw Error(yaml.where(p + key) + " " + what);
   };
-  check(o.merge_angle_deg >= 0 && o.merge_angle_deg < 90, "merge_angle_deg",
-        "must be in [0, 90)");
+  check(o.merge_angle_deg >= 0 && o.merge_angle_deg < 90, "merge_angle_deg", "must be in [0, 90)");
   check(o.merge_distance_m >= 0, "merge_distance_m", "must be >= 0");
   check(o.merge_min_overlap_m >= 0, "merge_min_overlap_m", "must be >= 0");
   check(o.index_cell_m > 0, "index_cell_m", "must be > 0");
@@ -178,7 +177,8 @@ void LineMap::fit(Line* line) {
 void LineMap::foldOldMembers(Line* line) {
   // Fold the oldest members (all but the newest half of the budget) into one fixed member.
   auto& ms = line->members;
-  std::sort(ms.begin(), ms.end(), [](const Member& a, const Member& b) { return a.stamp < b.stamp; });
+  std::sort(ms.begin(), ms.end(),
+            [](const Member& a, const Member& b) { return a.stamp < b.stamp; });
   const std::size_t keep = static_cast<std::size_t>(options_.max_members_per_line / 2);
   const std::size_t n_fold = ms.size() - keep;
   Line old;
@@ -352,14 +352,14 @@ std::size_t LineMap::memoryBytes() const {
   constexpr std::size_t kNode = 2 * sizeof(void*);
   std::size_t bytes = 0;
   for (const auto& [key, line] : lines_)
-    bytes += sizeof(std::pair<const int, Line>) + kNode +
-             line.members.capacity() * sizeof(Member) + line.cells.capacity() * sizeof(int64_t);
+    bytes += sizeof(std::pair<const int, Line>) + kNode + line.members.capacity() * sizeof(Member) +
+             line.cells.capacity() * sizeof(int64_t);
   bytes += lines_.bucket_count() * sizeof(void*);
   bytes += line_of_id_.size() * (sizeof(std::pair<const int, int>) + kNode) +
            line_of_id_.bucket_count() * sizeof(void*);
   for (const auto& [cell, keys] : grid_)
-    bytes += sizeof(std::pair<const int64_t, std::vector<int>>) + kNode +
-             keys.capacity() * sizeof(int);
+    bytes +=
+        sizeof(std::pair<const int64_t, std::vector<int>>) + kNode + keys.capacity() * sizeof(int);
   bytes += grid_.bucket_count() * sizeof(void*);
   return bytes;
 }

@@ -1,13 +1,13 @@
 #include "alvio/mapping/map_files.h"
 
-#include <cstdio>
-#include <filesystem>
-#include <fstream>
-#include <iomanip>
 #include <mrpt/opengl/COpenGLScene.h>
 #include <mrpt/opengl/CPointCloud.h>
 #include <mrpt/opengl/CSetOfLines.h>
 #include <octomap/OcTree.h>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
 #include <sstream>
 
 #include "alvio/common/error.h"

@@ -127,9 +127,8 @@ SyntheticRoom makeSyntheticRoom(const SyntheticRoomOptions& o) {
       const auto samples = sampleSegment(edge.p0, edge.p1, 0.05);
       int best_begin = -1, best_len = 0, begin = -1;
       for (int i = 0; i <= static_cast<int>(samples.size()); ++i) {
-        const bool vis =
-            i < static_cast<int>(samples.size()) && visible(kf.T_w_c, samples[i], o.view_range_m,
-                                                            half_fov_tan);
+        const bool vis = i < static_cast<int>(samples.size()) &&
+                         visible(kf.T_w_c, samples[i], o.view_range_m, half_fov_tan);
         if (vis && begin < 0) begin = i;
         if (!vis && begin >= 0) {
           if (i - begin > best_len) best_len = i - begin, best_begin = begin;

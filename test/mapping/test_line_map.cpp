@@ -116,11 +116,11 @@ TEST(LineMap, DropsRareShortLongAndFarLinesAtSave) {
   o.max_length_m = 30;
   o.max_depth_m = 20;
   LineMap map(o);
-  map.addSegment(1, Vector3d(0, 0, 0), Vector3d(2, 0, 0), 10, kCamera);      // kept
-  map.addSegment(2, Vector3d(0, 1, 0), Vector3d(2, 1, 0), 2, kCamera);       // too rare
-  map.addSegment(3, Vector3d(0, 2, 0), Vector3d(0.05, 2, 0), 10, kCamera);   // too short
-  map.addSegment(4, Vector3d(0, 3, 0), Vector3d(50, 3, 0), 10, kCamera);     // too long
-  map.addSegment(5, Vector3d(0, 40, 0), Vector3d(2, 40, 0), 10, kCamera);    // too far
+  map.addSegment(1, Vector3d(0, 0, 0), Vector3d(2, 0, 0), 10, kCamera);     // kept
+  map.addSegment(2, Vector3d(0, 1, 0), Vector3d(2, 1, 0), 2, kCamera);      // too rare
+  map.addSegment(3, Vector3d(0, 2, 0), Vector3d(0.05, 2, 0), 10, kCamera);  // too short
+  map.addSegment(4, Vector3d(0, 3, 0), Vector3d(50, 3, 0), 10, kCamera);    // too long
+  map.addSegment(5, Vector3d(0, 40, 0), Vector3d(2, 40, 0), 10, kCamera);   // too far
   EXPECT_EQ(map.size(), 5u);  // nothing is deleted while mapping
   const auto kept = map.filteredLines();
   ASSERT_EQ(kept.size(), 1u);

@@ -76,7 +76,7 @@ TEST(MapBuilder, OptionsFromTheShippedConfigWithoutUnknownKeyWarnings) {
   EXPECT_NE(warnings.front().find("mapping.octomap.resolutoin"), std::string::npos);
 }
 
-TEST(EstimatorKeyframeFeed, ReportsOldestKeyframeLandmarksOnTheWalls) {
+TEST(EstimatorKeyframeFeed, ReportsOldestKeyframeLandmarksOnce) {
   const Config c = Config::load(test::sourcePath("config/euroc.yaml"));
   test::ScenarioOptions so;
   so.duration_s = 10;
@@ -91,37 +91,63 @@ TEST(EstimatorKeyframeFeed, ReportsOldestKeyframeLandmarksOnTheWalls) {
       estimator.addImu(imu[next_imu++]);
     if (next_imu < imu.size()) estimator.addImu(imu[next_imu++]);
     estimator.addFrame(frame);
-    if (auto kf = feed.poll(estimator)) keyframes.push_back(*kf);
+    auto kf = feed.poll(estimator);
     EXPECT_FALSE(feed.poll(estimator).has_value()) << "reported the same keyframe twice";
+    if (!kf) continue;
+    // Exactly the estimator's landmarks anchored in its oldest keyframe, seen from there.
+    const auto window = estimator.windowStates();
+    EXPECT_DOUBLE_EQ(kf->t, window.front().t);
+    EXPECT_LT((kf->T_w_c.translation() -
+               (window.front().p + window.front().q * c.camera.T_b_c.translation()))
+                  .norm(),
+              1e-9);
+    const auto positions = estimator.landmarkPositions();
+    std::size_t anchored = 0;
+    for (const auto& [id, p] : positions)
+      if (estimator.points().landmarks().at(id).start_frame == 0) ++anchored;
+    EXPECT_EQ(kf->points.size(), anchored);
+    for (const LandmarkPoint& p : kf->points) {
+      EXPECT_LT((positions.at(p.id) - p.p_w).norm(), 1e-12);
+      EXPECT_GT((kf->T_w_c.inverse() * p.p_w).z(), 0.0) << "behind the reporting camera";
+    }
+    keyframes.push_back(*kf);
   }
-  const auto rest = feed.flush(estimator);
   ASSERT_GT(keyframes.size(), 20u);
-  EXPECT_FALSE(rest.empty());
-  // Align the estimated keyframe camera centres with the truth, then the landmarks must
-  // lie on the walls of the scenario's 12 x 12 x 5 m room (x, y = +-6, z = -1 or 4).
+  EXPECT_FALSE(feed.flush(estimator).empty());
+
+  // Against the truth: align the keyframe body positions (after the first 4 s, once the
+  // estimator has settled) and measure how far the landmarks lie from the walls of the
+  // scenario's 12 x 12 x 5 m room (x, y = +-6, z = -1 or 4). Landmark accuracy is the
+  // estimator's; this checks that the feed hands over world-frame positions.
   Points3 est, truth;
   const Trajectory gt = scenario.groundTruth();
+  std::vector<const KeyframeLandmarks*> settled;
   for (const auto& kf : keyframes) {
-    auto it = std::min_element(gt.begin(), gt.end(), [&](const StampedPose& a, const StampedPose& b) {
-      return std::abs(a.t - kf.t) < std::abs(b.t - kf.t);
-    });
+    if (kf.t < keyframes.front().t + 4) continue;
+    auto it =
+        std::min_element(gt.begin(), gt.end(), [&](const StampedPose& a, const StampedPose& b) {
+          return std::abs(a.t - kf.t) < std::abs(b.t - kf.t);
+        });
     ASSERT_LT(std::abs(it->t - kf.t), 1e-3);
     est.push_back((kf.T_w_c * c.camera.T_b_c.inverse()).translation());
     truth.push_back(it->p);
+    settled.push_back(&kf);
   }
-  const Similarity3 align = alignPoints(est, truth, AlignmentMode::kSe3);
-  std::size_t n = 0, on_wall = 0;
-  for (const auto& kf : keyframes) {
-    ASSERT_FALSE(kf.points.empty());
-    for (const LandmarkPoint& p : kf.points) {
-      // In front of the keyframe camera that reports it.
-      EXPECT_GT((kf.T_w_c.inverse() * p.p_w).z(), 0.0);
+  ASSERT_GT(settled.size(), 10u);
+  const Similarity3 align = alignPoints(est, truth, AlignmentMode::kSE3);
+  for (std::size_t i = 0; i < est.size(); ++i)
+    EXPECT_LT((align.apply(est[i]) - truth[i]).norm(), 0.1);
+  std::vector<double> d;
+  for (const KeyframeLandmarks* kf : settled)
+    for (const LandmarkPoint& p : kf->points) {
       const Eigen::Vector3d q = align.apply(p.p_w);
-      const double d = std::min({std::abs(std::abs(q.x()) - 6), std::abs(std::abs(q.y()) - 6),
-                                 std::abs(q.z() + 1), std::abs(q.z() - 4)});
-      ++n;
-      if (d < 0.2) ++on_wall;
+      d.push_back(std::min({std::abs(std::abs(q.x()) - 6), std::abs(std::abs(q.y()) - 6),
+                            std::abs(q.z() + 1), std::abs(q.z() - 4)}));
     }
-  }
-  EXPECT_GT(static_cast<double>(on_wall) / n, 0.95) << on_wall << " of " << n;
+  ASSERT_GT(d.size(), 200u);
+  std::sort(d.begin(), d.end());
+  std::cout << d.size() << " landmarks: distance to the nearest wall median " << d[d.size() / 2]
+            << " m, 75th percentile " << d[d.size() * 3 / 4] << " m\n";
+  EXPECT_LT(d[d.size() / 2], 0.1);
+  EXPECT_LT(d[d.size() * 3 / 4], 0.2);
 }

@@ -35,8 +35,8 @@ TEST(MapEvaluation, AngleToleranceRejectsCrossingLines) {
   // 10 deg off edge 0, crossing it at x = 2: only ~1 m near the crossing is within 10 cm,
   // and none within 3 deg.
   const double a = 10 * kDeg;
-  const std::vector<Segment3> map = {
-      {Vector3d(2 - 2 * std::cos(a), -2 * std::sin(a), 0), Vector3d(2 + 2 * std::cos(a), 2 * std::sin(a), 0)}};
+  const std::vector<Segment3> map = {{Vector3d(2 - 2 * std::cos(a), -2 * std::sin(a), 0),
+                                      Vector3d(2 + 2 * std::cos(a), 2 * std::sin(a), 0)}};
   EXPECT_NEAR(evaluateLineMap(map, kEdges, 0.1, 3 * kDeg).precision, 0.0, 1e-9);
   const LineMapEvaluation loose = evaluateLineMap(map, kEdges, 0.1, 15 * kDeg);
   EXPECT_NEAR(loose.precision, 2 * 0.1 / std::sin(a) / 4.0, 0.03);
@@ -51,8 +51,8 @@ TEST(MapEvaluation, OccupancyFractionNearSurface) {
   for (int i = 0; i < 30; ++i) pts.push_back(Vector3d(0.05 + 0.1 * i, 0.05, 0.05));  // on z = 0
   for (int i = 0; i < 10; ++i) pts.push_back(Vector3d(0.05 + 0.1 * i, 0.05, 1.05));  // 1 m off
   map.insert(Vector3d(0, 0, 5), pts);
-  const OccupancyEvaluation e =
-      evaluateOccupancy(map.tree(), [](const Vector3d& p) { return std::abs(p.z()); }, 0.2);
+  const OccupancyEvaluation e = evaluateOccupancy(
+      map.tree(), [](const Vector3d& p) { return std::abs(p.z()); }, 0.2);
   EXPECT_EQ(e.occupied_voxels, 40u);
   EXPECT_EQ(e.within_tolerance, 30u);
   EXPECT_NEAR(e.fraction, 0.75, 1e-9);

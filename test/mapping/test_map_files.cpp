@@ -3,14 +3,14 @@
 // octomap-tools' bt2vrml reads the .bt.
 #include <gtest/gtest.h>
 
-#include <cstdlib>
-#include <filesystem>
-#include <fstream>
-#include <map>
 #include <mrpt/opengl/COpenGLScene.h>
 #include <mrpt/opengl/CPointCloud.h>
 #include <mrpt/opengl/CSetOfLines.h>
 #include <octomap/OcTree.h>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
 #include <sstream>
 
 #include "alvio/common/error.h"
@@ -122,11 +122,14 @@ TEST(MapFiles, EveryFileReloadsWithItsOwnLibrary) {
   // MRPT scene.
   mrpt::opengl::COpenGLScene scene;
   ASSERT_TRUE(scene.loadFromFile(paths.scene));
-  auto lines = std::dynamic_pointer_cast<mrpt::opengl::CSetOfLines>(scene.getByName(kSceneLinesName));
+  auto lines =
+      std::dynamic_pointer_cast<mrpt::opengl::CSetOfLines>(scene.getByName(kSceneLinesName));
   auto trajectory =
       std::dynamic_pointer_cast<mrpt::opengl::CSetOfLines>(scene.getByName(kSceneTrajectoryName));
-  auto points = std::dynamic_pointer_cast<mrpt::opengl::CPointCloud>(scene.getByName(kScenePointsName));
-  auto voxels = std::dynamic_pointer_cast<mrpt::opengl::CPointCloud>(scene.getByName(kSceneVoxelsName));
+  auto points =
+      std::dynamic_pointer_cast<mrpt::opengl::CPointCloud>(scene.getByName(kScenePointsName));
+  auto voxels =
+      std::dynamic_pointer_cast<mrpt::opengl::CPointCloud>(scene.getByName(kSceneVoxelsName));
   ASSERT_TRUE(lines && trajectory && points && voxels);
   EXPECT_EQ(lines->size(), kept.size());
   EXPECT_EQ(trajectory->size(), map.trajectory().size() - 1);

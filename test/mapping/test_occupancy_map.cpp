@@ -2,6 +2,7 @@
 // the sensor model and range parameters are applied.
 #include <gtest/gtest.h>
 
+#include "alvio/common/error.h"
 #include "alvio/config/yaml_reader.h"
 #include "alvio/mapping/occupancy_map.h"
 

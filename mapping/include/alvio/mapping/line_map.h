@@ -32,10 +32,10 @@ class YamlReader;
 
 struct LineMapOptions {
   // Merging of different landmark IDs.
-  double merge_angle_deg = 3.0;   ///< maximum angle between the two lines
-  double merge_distance_m = 0.05; ///< shorter segment's endpoints to the longer one's line
-  double merge_min_overlap_m = 0; ///< overlap of the extents along the longer line (>= 0)
-  double index_cell_m = 0.5;      ///< cell size of the spatial hash grid
+  double merge_angle_deg = 3.0;    ///< maximum angle between the two lines
+  double merge_distance_m = 0.05;  ///< shorter segment's endpoints to the longer one's line
+  double merge_min_overlap_m = 0;  ///< overlap of the extents along the longer line (>= 0)
+  double index_cell_m = 0.5;       ///< cell size of the spatial hash grid
   /// A map line keeps at most this many member estimates; older ones are folded into
   /// one fixed member (their IDs are then forgotten), which bounds the memory of a
   /// line seen again and again.
@@ -45,10 +45,10 @@ struct LineMapOptions {
   /// 0 keeps them until saving.
   int prune_weak_after_keyframes = 30;
   // Filtering when the map is saved.
-  int min_observations = 4;     ///< summed image observations of a kept line
-  double min_length_m = 0.1;    ///< shorter lines are dropped
-  double max_length_m = 30.0;   ///< longer lines are treated as triangulation outliers
-  double max_depth_m = 20.0;    ///< lines never seen closer than this are outliers (<= 0: off)
+  int min_observations = 4;    ///< summed image observations of a kept line
+  double min_length_m = 0.1;   ///< shorter lines are dropped
+  double max_length_m = 30.0;  ///< longer lines are treated as triangulation outliers
+  double max_depth_m = 20.0;   ///< lines never seen closer than this are outliers (<= 0: off)
 
   /// Read the keys under `prefix` ("mapping.lines"); throws alvio::Error naming the key.
   static LineMapOptions load(const YamlReader& yaml, const std::string& prefix);
@@ -58,8 +58,8 @@ struct LineMapOptions {
 struct MapLine {
   int id = -1;  ///< the smallest landmark ID merged into it
   Eigen::Vector3d p0 = Eigen::Vector3d::Zero(), p1 = Eigen::Vector3d::Zero();
-  int observations = 0;  ///< image observations, summed over its landmarks
-  int landmarks = 0;     ///< landmark IDs merged into it
+  int observations = 0;    ///< image observations, summed over its landmarks
+  int landmarks = 0;       ///< landmark IDs merged into it
   double min_depth_m = 0;  ///< closest distance to a camera that reported it
   double length() const { return (p1 - p0).norm(); }
   Segment3 segment() const { return {p0, p1}; }
@@ -111,7 +111,7 @@ class LineMap {
     std::vector<Member> members;
     /// Fitted line: centroid and unit direction.
     Eigen::Vector3d c = Eigen::Vector3d::Zero(), u = Eigen::Vector3d::Zero();
-    double t0 = 0, t1 = 0; ///< extent along u from c
+    double t0 = 0, t1 = 0;  ///< extent along u from c
     int observations = 0, landmarks = 0;
     double min_depth = 0;
     int64_t last_keyframe = 0;   ///< keyframe of the last update
@@ -135,8 +135,8 @@ class LineMap {
 
   LineMapOptions options_;
   double cos_merge_angle_ = 1;
-  std::unordered_map<int, Line> lines_;           // by internal key
-  std::unordered_map<int, int> line_of_id_;       // landmark id -> line key
+  std::unordered_map<int, Line> lines_;                 // by internal key
+  std::unordered_map<int, int> line_of_id_;             // landmark id -> line key
   std::unordered_map<int64_t, std::vector<int>> grid_;  // cell -> line keys
   int next_key_ = 0;
   uint64_t stamp_ = 0;

@@ -18,10 +18,10 @@ class YamlReader;
 
 /// The `mapping:` section of the configuration.
 struct MappingOptions {
-  bool enabled = true;      ///< the offline runner builds and writes the map
-  bool write_scene = true;  ///< write map.3Dscene (MRPT) besides the other files
-  LineMapOptions lines;          ///< mapping.lines.*
-  OccupancyMapOptions octomap;   ///< mapping.octomap.*
+  bool enabled = true;          ///< the offline runner builds and writes the map
+  bool write_scene = true;      ///< write map.3Dscene (MRPT) besides the other files
+  LineMapOptions lines;         ///< mapping.lines.*
+  OccupancyMapOptions octomap;  ///< mapping.octomap.*
 
   /// Read `prefix` ("mapping"); absent keys keep their defaults. Throws alvio::Error
   /// naming the key; unknown keys under the prefix are logged as warnings.

@@ -23,10 +23,10 @@ struct OccupancyMapOptions {
   /// Rays are cut at this range (m), -1 = unlimited: `sensor_model/max_range`. Beyond it a
   /// landmark only carves free space up to the range and is not marked occupied.
   double max_range = -1;
-  double hit = 0.7;          ///< `sensor_model/hit`
-  double miss = 0.4;         ///< `sensor_model/miss`
-  double clamp_min = 0.12;   ///< `sensor_model/min`
-  double clamp_max = 0.97;   ///< `sensor_model/max`
+  double hit = 0.7;               ///< `sensor_model/hit`
+  double miss = 0.4;              ///< `sensor_model/miss`
+  double clamp_min = 0.12;        ///< `sensor_model/min`
+  double clamp_max = 0.97;        ///< `sensor_model/max`
   double line_sample_step_m = 0;  ///< spacing of samples along lines; 0 = resolution / 2
   bool carve_free_space = true;   ///< false: mark endpoints only, no ray casting
   /// Lines reported with fewer image observations do not go into the tree (a one-off
@@ -35,7 +35,8 @@ struct OccupancyMapOptions {
 
   /// Read the keys under `prefix` ("mapping.octomap"): resolution, sensor_model_max_range,
   /// sensor_model_hit, sensor_model_miss, sensor_model_min, sensor_model_max,
-  /// line_sample_step_m, carve_free_space, min_line_observations. Throws alvio::Error naming the key.
+  /// line_sample_step_m, carve_free_space, min_line_observations. Throws alvio::Error naming the
+  /// key.
   static OccupancyMapOptions load(const YamlReader& yaml, const std::string& prefix);
   double lineStep() const { return line_sample_step_m > 0 ? line_sample_step_m : resolution / 2; }
 };

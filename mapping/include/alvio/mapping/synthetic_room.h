@@ -20,12 +20,12 @@ struct SyntheticRoomOptions {
   Eigen::Vector3d size = Eigen::Vector3d(8, 6, 3);  ///< room from (0,0,0) to size (m)
   int laps = 4;
   int keyframes_per_lap = 60;
-  int keyframes_per_track = 6;     ///< a line landmark ID lives at most this many keyframes
-  int frames_per_keyframe = 3;     ///< image observations added per keyframe to a track
+  int keyframes_per_track = 6;  ///< a line landmark ID lives at most this many keyframes
+  int frames_per_keyframe = 3;  ///< image observations added per keyframe to a track
   /// Std of each coordinate of a track's line estimate at the edge ends (fixed per track);
   /// each report adds a jitter of a third of it.
   double endpoint_noise_m = 0.01;
-  double point_noise_m = 0.01;     ///< std of each point coordinate
+  double point_noise_m = 0.01;  ///< std of each point coordinate
   int points_per_keyframe = 40;
   double outliers_per_keyframe = 0.5;  ///< mean number of spurious one-off segments
   double view_range_m = 7;
