@@ -121,9 +121,13 @@ int main(int argc, char** argv) {
     }
     Trajectory trajectory;
     if (fs::exists(dir / "trajectory.tum")) {
-      trajectory = readTrajectory((dir / "trajectory.tum").string(), TrajectoryFormat::kTum);
+      try {
+        trajectory = readTrajectory((dir / "trajectory.tum").string(), TrajectoryFormat::kTum);
+      } catch (const Error& e) {
+        std::cout << "trajectory: not used (" << e.what() << ")\n";
+      }
       for (const StampedPose& p : trajectory) box.add(p.p);
-      std::cout << "trajectory: " << trajectory.size() << " poses\n";
+      if (!trajectory.empty()) std::cout << "trajectory: " << trajectory.size() << " poses\n";
     }
     if (box.valid())
       std::cout << "extent: [" << box.lo.x() << ", " << box.lo.y() << ", " << box.lo.z() << "] .. ["
