@@ -2,9 +2,9 @@
 // (plumbing on the shared EuRoC slice, where the VIO does not initialise: an empty map).
 #include <gtest/gtest.h>
 
+#include <octomap/OcTree.h>
 #include <cstdio>
 #include <filesystem>
-#include <octomap/OcTree.h>
 
 #include "alvio/mapping/map_files.h"
 #include "test_support.h"
