@@ -1,5 +1,6 @@
 // alvio_run: the offline runner. Reads an EuRoC folder or a rosbag, runs the
-// whole pipeline on every frame and writes the trajectory and timing.
+// whole pipeline on every frame and writes the trajectory and timing, and the map
+// (octomap.bt, lines.ply, lines.csv, map.3Dscene) unless mapping.enabled is false.
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -8,8 +9,11 @@
 #include "alvio/common/error.h"
 #include "alvio/common/logging.h"
 #include "alvio/config/config.h"
+#include "alvio/config/yaml_reader.h"
 #include "alvio/logging/run_logger.h"
+#include "alvio/mapping/map_observer.h"
 #include "alvio/pipeline/offline_runner.h"
+#include "alvio/pipeline/vio_pipeline.h"
 #include "rosbag_source.h"
 
 using namespace alvio;
@@ -51,7 +55,14 @@ int main(int argc, char** argv) {
       logger = std::make_unique<RunLogger>(config.logger);
       options.observers.push_back(logger.get());
     }
+    std::unique_ptr<MapObserver> map;
+    const MappingOptions mapping = MappingOptions::load(YamlReader(args.get("config")), "mapping");
+    if (mapping.enabled) {
+      map = std::make_unique<MapObserver>(mapping, config.camera.T_b_c);
+      options.observers.push_back(map.get());
+    }
     const RunResult r = runOffline(*source, config, options);
+    if (map) std::cout << "map:\n" << map->summary().toString();
 
     std::cout << "frames: " << r.frames << ", poses: " << r.poses << ", resets: " << r.resets
               << ", skipped images: " << r.skipped_images << "\n";

@@ -18,6 +18,7 @@ Config Config::load(const std::string& path) {
   c.estimator = EstimatorOptions::load(yaml, "estimator");
   c.lines = LineTrackerOptions::load(yaml, "lines");
   c.logger = LoggerOptions::load(yaml, "logger");
+  yaml.markKnown("mapping");  // read by alvio_mapping (MappingOptions::load)
   yaml.warnUnknownKeys();
   return c;
 }

@@ -461,6 +461,7 @@ LineSegments3 Estimator::takeRetiredLines() {
     seg.start = toOutput(a).p;
     seg.end = toOutput(b).p;
     seg.direction_std_deg = l.direction_std_deg;
+    seg.observations = l.track_observations;
     out.push_back(seg);
   }
   return out;

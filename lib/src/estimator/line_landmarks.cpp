@@ -56,6 +56,7 @@ void LineLandmarks::removeFrame(int64_t frame_ns, const Eigen::Isometry3d& T_w_c
           retired.end_w = b;
           retired.has_extent = true;
           retired.direction_std_deg = directionStdDeg(line, views, sigma_);
+          retired.track_observations = static_cast<int>(views.size());
           retired_.push_back(retired);
         }
       }

@@ -28,6 +28,7 @@ PipelineOutput VioPipeline::addImage(const cv::Mat& gray, int64_t t_ns) {
   out.status = estimator_.status();
   if (out.has_pose) out.state = estimator_.latestState();
   out.events = estimator_.takeEvents();
+  out.retired_lines = estimator_.takeRetiredLines();
   return out;
 }
 

@@ -41,6 +41,8 @@ struct LineLandmark {
   /// 1-sigma uncertainty of the line's direction from its window observations [deg]
   /// (negative until computed). Lines seen with little parallax are poorly constrained.
   double direction_std_deg = -1;
+  /// Observations over the whole track (set when the line retires from the window).
+  int track_observations = 0;
 
   bool hasLine() const { return status != LineLandmarkStatus::kNew; }
   /// Set a new line (after triangulation or optimisation); the old extent is projected

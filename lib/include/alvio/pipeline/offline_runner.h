@@ -7,6 +7,7 @@
 //   summary.json     counts, timing summary, initialisation quality and ATE
 // and, when the dataset has ground truth, prints the ATE.
 
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -19,6 +20,8 @@
 #include "alvio/pipeline/sensor_source.h"
 
 namespace alvio {
+
+struct PipelineOutput;
 
 struct RunOptions {
   std::string out_dir;

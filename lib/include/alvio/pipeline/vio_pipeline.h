@@ -23,6 +23,8 @@ struct PipelineOutput {
   FeatureFrame features;
   FrameTiming timing;
   std::vector<EstimatorEvent> events;
+  /// Lines that left the estimator's window on this frame, refined over their whole track.
+  LineSegments3 retired_lines;
 };
 
 class VioPipeline {

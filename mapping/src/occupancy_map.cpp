@@ -1,0 +1,138 @@
+#include "alvio/mapping/occupancy_map.h"
+
+#include <algorithm>
+#include <limits>
+
+#include "alvio/common/error.h"
+#include "alvio/config/yaml_reader.h"
+#include "alvio/mapping/segment_geometry.h"
+
+namespace alvio {
+
+OccupancyMapOptions OccupancyMapOptions::load(const YamlReader& yaml, const std::string& prefix) {
+  OccupancyMapOptions o;
+  const std::string p = prefix + ".";
+  o.resolution = yaml.getDouble(p + "resolution", o.resolution);
+  o.max_range = yaml.getDouble(p + "sensor_model_max_range", o.max_range);
+  o.hit = yaml.getDouble(p + "sensor_model_hit", o.hit);
+  o.miss = yaml.getDouble(p + "sensor_model_miss", o.miss);
+  o.clamp_min = yaml.getDouble(p + "sensor_model_min", o.clamp_min);
+  o.clamp_max = yaml.getDouble(p + "sensor_model_max", o.clamp_max);
+  o.line_sample_step_m = yaml.getDouble(p + "line_sample_step_m", o.line_sample_step_m);
+  o.carve_free_space = yaml.getBool(p + "carve_free_space", o.carve_free_space);
+  o.min_line_observations = yaml.getInt(p + "min_line_observations", o.min_line_observations);
+  auto check = [&](bool ok, const std::string& key, const std::string& what) {
+    if (!ok) throw Error(yaml.where(p + key) + " " + what);
+  };
+  check(o.resolution > 0, "resolution", "must be > 0");
+  check(o.max_range == -1 || o.max_range > 0, "sensor_model_max_range", "must be > 0 or -1");
+  check(o.hit > 0.5 && o.hit < 1, "sensor_model_hit", "must be in (0.5, 1)");
+  check(o.miss > 0 && o.miss < 0.5, "sensor_model_miss", "must be in (0, 0.5)");
+  check(o.clamp_min > 0 && o.clamp_min < 0.5, "sensor_model_min", "must be in (0, 0.5)");
+  check(o.clamp_max > 0.5 && o.clamp_max < 1, "sensor_model_max", "must be in (0.5, 1)");
+  check(o.line_sample_step_m >= 0, "line_sample_step_m", "must be >= 0 (0: resolution / 2)");
+  return o;
+}
+
+OccupancyMap::OccupancyMap(const OccupancyMapOptions& options)
+    : options_(options), tree_(std::make_unique<octomap::OcTree>(options.resolution)) {
+  tree_->setProbHit(options.hit);
+  tree_->setProbMiss(options.miss);
+  tree_->setClampingThresMin(options.clamp_min);
+  tree_->setClampingThresMax(options.clamp_max);
+}
+
+void OccupancyMap::insert(const Eigen::Vector3d& origin_w,
+                          const std::vector<Eigen::Vector3d>& points_w) {
+  if (!origin_w.allFinite()) return;
+  const octomap::point3d origin(origin_w.x(), origin_w.y(), origin_w.z());
+  if (!options_.carve_free_space) {
+    for (const Eigen::Vector3d& p : points_w) {
+      if (!p.allFinite()) continue;
+      if (options_.max_range > 0 && (p - origin_w).norm() > options_.max_range) continue;
+      tree_->updateNode(octomap::point3d(p.x(), p.y(), p.z()), true);
+    }
+    return;
+  }
+  octomap::Pointcloud cloud;
+  cloud.reserve(points_w.size());
+  for (const Eigen::Vector3d& p : points_w)
+    if (p.allFinite()) cloud.push_back(p.x(), p.y(), p.z());
+  // discretize: one ray per end voxel, which matters for densely sampled lines.
+  tree_->insertPointCloud(cloud, origin, options_.max_range, /*lazy_eval=*/false,
+                          /*discretize=*/true);
+}
+
+void OccupancyMap::insertKeyframe(const KeyframeLandmarks& keyframe) {
+  std::vector<Eigen::Vector3d> pts;
+  pts.reserve(keyframe.points.size());
+  for (const LandmarkPoint& p : keyframe.points) pts.push_back(p.p_w);
+  for (const LandmarkSegment& l : keyframe.lines) {
+    if (!l.p0_w.allFinite() || !l.p1_w.allFinite()) continue;
+    if (l.observations < options_.min_line_observations) continue;
+    // A triangulation blow-up would otherwise turn into millions of samples.
+    const double step = std::max(options_.lineStep(), (l.p1_w - l.p0_w).norm() / 20000.0);
+    for (const Eigen::Vector3d& s : sampleSegment(l.p0_w, l.p1_w, step)) pts.push_back(s);
+  }
+  insert(keyframe.T_w_c.translation(), pts);
+}
+
+std::optional<double> OccupancyMap::occupancy(const Eigen::Vector3d& p_w) const {
+  const octomap::OcTreeNode* n = tree_->search(p_w.x(), p_w.y(), p_w.z());
+  if (!n) return std::nullopt;
+  return n->getOccupancy();
+}
+
+bool OccupancyMap::isOccupied(const Eigen::Vector3d& p_w) const {
+  const octomap::OcTreeNode* n = tree_->search(p_w.x(), p_w.y(), p_w.z());
+  return n && tree_->isNodeOccupied(n);
+}
+
+bool OccupancyMap::isFree(const Eigen::Vector3d& p_w) const {
+  const octomap::OcTreeNode* n = tree_->search(p_w.x(), p_w.y(), p_w.z());
+  return n && !tree_->isNodeOccupied(n);
+}
+
+VoxelCounts countVoxels(const octomap::OcTree& tree) {
+  VoxelCounts c;
+  const unsigned max_depth = tree.getTreeDepth();
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d hi = -lo;
+  for (auto it = tree.begin_leafs(), end = tree.end_leafs(); it != end; ++it) {
+    ++c.leaf_nodes;
+    const std::size_t n = std::size_t{1} << (3 * (max_depth - it.getDepth()));
+    if (tree.isNodeOccupied(*it)) {
+      c.occupied += n;
+      const double h = it.getSize() / 2;
+      const Eigen::Vector3d centre(it.getX(), it.getY(), it.getZ());
+      lo = lo.cwiseMin(centre - Eigen::Vector3d::Constant(h));
+      hi = hi.cwiseMax(centre + Eigen::Vector3d::Constant(h));
+    } else {
+      c.free += n;
+    }
+  }
+  if (c.occupied > 0) {
+    c.occupied_min = lo;
+    c.occupied_max = hi;
+  }
+  return c;
+}
+
+std::vector<Eigen::Vector3d> occupiedVoxelCentres(const octomap::OcTree& tree) {
+  std::vector<Eigen::Vector3d> out;
+  const double res = tree.getResolution();
+  for (auto it = tree.begin_leafs(), end = tree.end_leafs(); it != end; ++it) {
+    if (!tree.isNodeOccupied(*it)) continue;
+    const double size = it.getSize();
+    const int n = std::max(1, static_cast<int>(std::lround(size / res)));
+    const Eigen::Vector3d corner =
+        Eigen::Vector3d(it.getX(), it.getY(), it.getZ()) - Eigen::Vector3d::Constant(size / 2);
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j)
+        for (int k = 0; k < n; ++k)
+          out.push_back(corner + res * Eigen::Vector3d(i + 0.5, j + 0.5, k + 0.5));
+  }
+  return out;
+}
+
+}  // namespace alvio

@@ -1,0 +1,97 @@
+// OccupancyMap: sampled segments become occupied voxels, rays carve free space,
+// the sensor model and range parameters are applied.
+#include <gtest/gtest.h>
+
+#include "alvio/common/error.h"
+#include "alvio/config/yaml_reader.h"
+#include "alvio/mapping/occupancy_map.h"
+
+using namespace alvio;
+using Eigen::Vector3d;
+
+namespace {
+KeyframeLandmarks keyframeAtOrigin() {
+  KeyframeLandmarks kf;
+  kf.T_w_c = Eigen::Isometry3d::Identity();
+  return kf;
+}
+}  // namespace
+
+TEST(OccupancyMap, SampledSegmentIsOccupiedAndRaysAreFree) {
+  OccupancyMap map;  // 5 cm
+  KeyframeLandmarks kf = keyframeAtOrigin();
+  kf.lines.push_back({1, Vector3d(2.01, -0.5, 0.01), Vector3d(2.01, 0.5, 0.01), 5});
+  map.insertKeyframe(kf);
+  for (double y = -0.5; y <= 0.5; y += 0.025)
+    EXPECT_TRUE(map.isOccupied(Vector3d(2.01, y, 0.01))) << "y = " << y;
+  // On the rays from the camera: free. Behind the segment, or off the rays: unknown.
+  for (double x : {0.3, 1.0, 1.5, 1.85}) EXPECT_TRUE(map.isFree(Vector3d(x, 0, 0.01))) << x;
+  EXPECT_TRUE(map.isFree(Vector3d(1.0, 0.2, 0.01)));
+  EXPECT_FALSE(map.occupancy(Vector3d(2.5, 0, 0.01)).has_value());
+  EXPECT_FALSE(map.occupancy(Vector3d(1.0, 0, 1.0)).has_value());
+  const VoxelCounts c = map.counts();
+  EXPECT_GE(c.occupied, 20u);
+  EXPECT_LE(c.occupied, 25u);  // one row of voxels, not a smear
+  EXPECT_GT(c.free, 100u);
+  EXPECT_NEAR(c.occupied_min.x(), 2.0, 1e-6);
+  EXPECT_NEAR(c.occupied_max.x(), 2.05, 1e-6);
+}
+
+TEST(OccupancyMap, RepeatedMissesClearAVoxel) {
+  OccupancyMap map;
+  map.insert(Vector3d::Zero(), {Vector3d(1.02, 0.02, 0.02)});
+  ASSERT_TRUE(map.isOccupied(Vector3d(1.02, 0.02, 0.02)));
+  // Seen through: in log-odds a hit (0.7) is +0.85 and a miss (0.4) -0.41, so two misses
+  // leave it occupied and the third clears it.
+  map.insert(Vector3d::Zero(), {Vector3d(2.02, 0.02, 0.02)});
+  map.insert(Vector3d::Zero(), {Vector3d(2.02, 0.02, 0.02)});
+  EXPECT_TRUE(map.isOccupied(Vector3d(1.02, 0.02, 0.02)));
+  map.insert(Vector3d::Zero(), {Vector3d(2.02, 0.02, 0.02)});
+  EXPECT_TRUE(map.isFree(Vector3d(1.02, 0.02, 0.02)));
+}
+
+TEST(OccupancyMap, MaxRangeAndMinObservationsAndNoCarving) {
+  OccupancyMapOptions o;
+  o.max_range = 5;
+  o.resolution = 0.1;
+  OccupancyMap map(o);
+  EXPECT_DOUBLE_EQ(map.tree().getResolution(), 0.1);
+  EXPECT_NEAR(map.tree().getProbHit(), 0.7, 1e-6);
+  map.insert(Vector3d::Zero(), {Vector3d(10.05, 0.05, 0.05)});
+  EXPECT_FALSE(map.isOccupied(Vector3d(10.05, 0.05, 0.05)));
+  EXPECT_TRUE(map.isFree(Vector3d(4.5, 0.05, 0.05)));
+  EXPECT_FALSE(map.occupancy(Vector3d(6.05, 0.05, 0.05)).has_value());
+
+  KeyframeLandmarks kf = keyframeAtOrigin();
+  kf.lines.push_back({1, Vector3d(2, -0.5, 0.05), Vector3d(2, 0.5, 0.05), 1});  // too rare
+  map.insertKeyframe(kf);
+  EXPECT_EQ(map.counts().occupied, 0u);
+
+  OccupancyMapOptions no_carve;
+  no_carve.carve_free_space = false;
+  OccupancyMap hits_only(no_carve);
+  KeyframeLandmarks kf2 = keyframeAtOrigin();
+  kf2.points.push_back({1, Vector3d(1, 1, 1)});
+  hits_only.insertKeyframe(kf2);
+  EXPECT_EQ(hits_only.counts().occupied, 1u);
+  EXPECT_EQ(hits_only.counts().free, 0u);
+}
+
+TEST(OccupancyMap, OptionsUseOctomapServerNames) {
+  const YamlReader y = YamlReader::fromString(
+      "mapping:\n  octomap:\n    resolution: 0.1\n    sensor_model_hit: 0.8\n"
+      "    sensor_model_miss: 0.3\n    sensor_model_min: 0.1\n    sensor_model_max: 0.95\n"
+      "    sensor_model_max_range: 6\n",
+      "t.yaml");
+  const OccupancyMapOptions o = OccupancyMapOptions::load(y, "mapping.octomap");
+  EXPECT_DOUBLE_EQ(o.resolution, 0.1);
+  EXPECT_DOUBLE_EQ(o.max_range, 6);
+  OccupancyMap map(o);
+  EXPECT_NEAR(map.tree().getProbHit(), 0.8, 1e-6);
+  EXPECT_NEAR(map.tree().getProbMiss(), 0.3, 1e-6);
+  EXPECT_NEAR(map.tree().getClampingThresMin(), 0.1, 1e-6);
+  EXPECT_NEAR(map.tree().getClampingThresMax(), 0.95, 1e-6);
+  const YamlReader bad =
+      YamlReader::fromString("mapping:\n  octomap:\n    sensor_model_hit: 0.3\n", "t.yaml");
+  EXPECT_THROW(OccupancyMapOptions::load(bad, "mapping.octomap"), Error);
+}
