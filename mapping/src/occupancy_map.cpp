@@ -42,6 +42,10 @@ OccupancyMap::OccupancyMap(const OccupancyMapOptions& options)
   tree_->setClampingThresMax(options.clamp_max);
 }
 
+namespace {
+constexpr double kMaxRayLength_m = 100.0;
+}  // namespace
+
 void OccupancyMap::insert(const Eigen::Vector3d& origin_w,
                           const std::vector<Eigen::Vector3d>& points_w) {
   if (!origin_w.allFinite()) return;
@@ -56,8 +60,11 @@ void OccupancyMap::insert(const Eigen::Vector3d& origin_w,
   }
   octomap::Pointcloud cloud;
   cloud.reserve(points_w.size());
+  // Even with an unlimited range, a diverged landmark kilometres away would make the ray
+  // caster allocate millions of keys: such points are never inserted.
   for (const Eigen::Vector3d& p : points_w)
-    if (p.allFinite()) cloud.push_back(p.x(), p.y(), p.z());
+    if (p.allFinite() && (p - origin_w).norm() < kMaxRayLength_m)
+      cloud.push_back(p.x(), p.y(), p.z());
   // discretize: one ray per end voxel, which matters for densely sampled lines.
   tree_->insertPointCloud(cloud, origin, options_.max_range, /*lazy_eval=*/false,
                           /*discretize=*/true);

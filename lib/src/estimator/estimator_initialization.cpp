@@ -52,10 +52,12 @@ bool Estimator::initialStructure(double t) {
     double var = 0;
     for (const auto& x : g) var += (x - mean).squaredNorm();
     const double stddev = std::sqrt(var / g.size());
-    if (stddev < 0.25) {
+    // Below the threshold the sensor is essentially still: scale and gravity cannot be
+    // separated. Smooth motion above it is tried; the post-refinement gate catches bad cases.
+    if (stddev < options_.init_min_excitation) {
       std::ostringstream os;
-      os << "IMU excitation too low (acceleration std " << stddev
-         << " m/s^2 < 0.25): move the sensor";
+      os << "IMU excitation too low (acceleration std " << stddev << " m/s^2 < "
+         << options_.init_min_excitation << "): move the sensor";
       waitFor(&last_wait_reason_, &events_, t, os.str());
       return false;
     }

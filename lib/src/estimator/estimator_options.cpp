@@ -28,6 +28,7 @@ EstimatorOptions EstimatorOptions::load(const YamlReader& yaml, const std::strin
       yaml.getInt(p + "init_min_correspondences", o.init_min_correspondences);
   o.init_retry_interval_s = yaml.getDouble(p + "init_retry_interval_s", o.init_retry_interval_s);
   o.init_max_accel_bias = yaml.getDouble(p + "init_max_accel_bias", o.init_max_accel_bias);
+  o.init_min_excitation = yaml.getDouble(p + "init_min_excitation", o.init_min_excitation);
   o.init_accel_bias_sigma = yaml.getDouble(p + "init_accel_bias_sigma", o.init_accel_bias_sigma);
   o.init_gyro_bias_sigma = yaml.getDouble(p + "init_gyro_bias_sigma", o.init_gyro_bias_sigma);
   o.min_tracked_features = yaml.getInt(p + "min_tracked_features", o.min_tracked_features);

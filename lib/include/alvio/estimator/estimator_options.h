@@ -28,9 +28,10 @@ struct EstimatorOptions {
   LineTriangulationOptions line_triangulation;
 
   // Initialisation.
-  double init_min_parallax_px = 30;  ///< between the reference frame and the newest
+  double init_min_parallax_px = 80;  ///< rotation-compensated, reference frame to newest
   int init_min_correspondences = 20;
   double init_retry_interval_s = 0.1;
+  double init_min_excitation = 0.005;  ///< std of mean acceleration per frame [m/s^2]
   double init_accel_bias_sigma = 0.2;  ///< bias prior at initialisation [m/s^2] (<= 0: none)
   double init_gyro_bias_sigma = 0.05;  ///< [rad/s]
   double init_max_accel_bias = 0.5;    ///< reject an initialisation that needs a larger bias
