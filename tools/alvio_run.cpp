@@ -12,6 +12,7 @@
 #include "alvio/config/yaml_reader.h"
 #include "alvio/logging/run_logger.h"
 #include "alvio/mapping/map_observer.h"
+#include "alvio/pipeline/analysis_writer.h"
 #include "alvio/pipeline/offline_runner.h"
 #include "alvio/pipeline/vio_pipeline.h"
 #include "rosbag_source.h"
@@ -29,11 +30,13 @@ int main(int argc, char** argv) {
   args.flag("no-lines", "points only (no line front end, no line landmarks)");
   args.option("line-tracker", "flow (ALVIO optical flow) | descriptor (PL-VIO LBD baseline)");
   args.flag("quiet", "no progress bar");
+  args.option("analysis", "write sensitivity-analysis records (CSV) into this folder");
   args.flag("no-log", "no MRPT logs (rawlog, 3D scene, alvio.log); also config logger.enabled");
   try {
     if (!args.parse(argc, argv)) return 0;
     Config config = Config::load(args.get("config"));
     if (args.isSet("no-lines")) config.estimator.use_lines = false;
+    if (args.isSet("analysis")) config.estimator.record_analysis = true;
     if (args.isSet("line-tracker")) {
       config.lines.tracker = args.get("line-tracker");
       if (config.lines.tracker != "flow" && config.lines.tracker != "descriptor")
@@ -54,6 +57,11 @@ int main(int argc, char** argv) {
     if (config.logger.enabled && !args.isSet("no-log")) {
       logger = std::make_unique<RunLogger>(config.logger);
       options.observers.push_back(logger.get());
+    }
+    std::unique_ptr<AnalysisWriter> analysis;
+    if (args.isSet("analysis")) {
+      analysis = std::make_unique<AnalysisWriter>(args.get("analysis"));
+      options.observers.push_back(analysis.get());
     }
     std::unique_ptr<MapObserver> map;
     const MappingOptions mapping = MappingOptions::load(YamlReader(args.get("config")), "mapping");

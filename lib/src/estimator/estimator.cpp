@@ -41,6 +41,7 @@ void Estimator::clearState() {
   const int n = W_ + 1;
   headers_.assign(n, 0.0);
   header_ns_.assign(n, 0);
+  intensity_.assign(n, 0.0);
   Ps_.assign(n, Eigen::Vector3d::Zero());
   Vs_.assign(n, Eigen::Vector3d::Zero());
   Bas_.assign(n, Eigen::Vector3d::Zero());
@@ -177,6 +178,7 @@ bool Estimator::addFrame(const FeatureFrame& frame, FrameTiming* timing) {
                          : Marginalization::kSecondNew;
   headers_[frame_count_] = t;
   header_ns_[frame_count_] = frame.t_ns;
+  intensity_[frame_count_] = frame.mean_intensity;
   if (options_.use_lines) lines_.addFrame(frame.t_ns, frame.lines);
 
   ImageFrame image;
@@ -322,8 +324,10 @@ void Estimator::slideWindow() {
     back_R0_ = Rs_[0];
     back_P0_ = Ps_[0];
     if (frame_count_ == W_) {
+      if (options_.record_analysis && status_ == EstimatorStatus::kTracking) recordWindow();
       for (int i = 0; i < W_; ++i) {
         headers_[i] = headers_[i + 1];
+        intensity_[i] = intensity_[i + 1];
         header_ns_[i] = header_ns_[i + 1];
         Ps_[i] = Ps_[i + 1];
         Vs_[i] = Vs_[i + 1];
@@ -367,6 +371,7 @@ void Estimator::slideWindow() {
     lines_.removeFrame(header_ns_[W_ - 1], cameraPose(header_ns_[W_ - 1]));
     headers_[W_ - 1] = headers_[W_];
     header_ns_[W_ - 1] = header_ns_[W_];
+    intensity_[W_ - 1] = intensity_[W_];
     Ps_[W_ - 1] = Ps_[W_];
     Vs_[W_ - 1] = Vs_[W_];
     Rs_[W_ - 1] = Rs_[W_];
@@ -447,6 +452,34 @@ LineSegments3 Estimator::lineSegments(double max_direction_std_deg) const {
     seg.direction_std_deg = l.direction_std_deg;
     out.push_back(seg);
   }
+  return out;
+}
+
+void Estimator::recordWindow() {
+  WindowTrackRecord r;
+  r.t = headers_[0];
+  r.frames = frame_count_ + 1;
+  for (int i = 0; i <= frame_count_; ++i) r.mean_intensity += intensity_[i] / r.frames;
+  r.motion_m = (Ps_[frame_count_] - Ps_[0]).cwiseAbs().sum();
+  for (const auto& [id, l] : points_.landmarks()) {
+    if (l.start_frame != 0) continue;
+    r.points.push_back({id, l.sightings.front().px, static_cast<int>(l.sightings.size())});
+  }
+  const double fx = camera_.intrinsics[0], fy = camera_.intrinsics[1];
+  const double cx = camera_.intrinsics[2], cy = camera_.intrinsics[3];
+  for (const auto& [id, l] : lines_.landmarks()) {
+    const auto first = l.observations.find(header_ns_[0]);
+    if (first == l.observations.end()) continue;
+    const Eigen::Vector2d mid = 0.5 * (first->second.start_norm + first->second.end_norm);
+    r.lines.push_back({id, Eigen::Vector2d(fx * mid.x() + cx, fy * mid.y() + cy),
+                       static_cast<int>(l.observations.size())});
+  }
+  window_records_.push_back(std::move(r));
+}
+
+std::vector<WindowTrackRecord> Estimator::takeWindowRecords() {
+  std::vector<WindowTrackRecord> out;
+  out.swap(window_records_);
   return out;
 }
 

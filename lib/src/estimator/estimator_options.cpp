@@ -19,6 +19,7 @@ EstimatorOptions EstimatorOptions::load(const YamlReader& yaml, const std::strin
       yaml.getDouble(p + "outlier_reprojection_px", o.outlier_reprojection_px);
   o.imu_noise_scale = yaml.getDouble(p + "imu_noise_scale", o.imu_noise_scale);
   o.use_lines = yaml.getBool(p + "use_lines", o.use_lines);
+  o.record_analysis = yaml.getBool(p + "record_analysis", o.record_analysis);
   o.line_sigma_px = yaml.getDouble(p + "line_sigma_px", o.line_sigma_px);
   o.line_min_observations = yaml.getInt(p + "line_min_observations", o.line_min_observations);
   o.line_outlier_px = yaml.getDouble(p + "line_outlier_px", o.line_outlier_px);

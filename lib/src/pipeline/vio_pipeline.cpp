@@ -29,6 +29,7 @@ PipelineOutput VioPipeline::addImage(const cv::Mat& gray, int64_t t_ns) {
   if (out.has_pose) out.state = estimator_.latestState();
   out.events = estimator_.takeEvents();
   out.retired_lines = estimator_.takeRetiredLines();
+  out.window_records = estimator_.takeWindowRecords();
   return out;
 }
 

@@ -55,6 +55,22 @@ struct LineSegment3 {
 };
 using LineSegments3 = std::vector<LineSegment3, Eigen::aligned_allocator<LineSegment3>>;
 
+/// Tracking statistics of one sliding window, for the sensitivity analysis (ALVIO Sec. 3):
+/// every feature seen in the window's first frame, where it was, and in how many of the
+/// window's frames it was tracked; the window's illumination and motion.
+struct WindowTrackRecord {
+  struct Feature {
+    int id = -1;
+    Eigen::Vector2d px = Eigen::Vector2d::Zero();  ///< in the first frame (lines: midpoint)
+    int tracked_frames = 0;                        ///< window frames that observe it
+  };
+  double t = 0;               ///< time of the window's first frame
+  int frames = 0;             ///< frames in the window
+  double mean_intensity = 0;  ///< average pixel value over the window's frames
+  double motion_m = 0;        ///< sum of |dx|+|dy|+|dz| between first and last frame
+  std::vector<Feature> points, lines;
+};
+
 /// Something a user should know about: initialisation, a reset, why it waits.
 struct EstimatorEvent {
   enum class Kind { kWaiting, kInitialized, kFailure, kReset };
@@ -91,6 +107,8 @@ class Estimator {
   /// with the final poses of every frame that saw it (for maps). Output frame.
   LineSegments3 takeRetiredLines();
   int resetCount() const { return reset_count_; }
+  /// Window records since the last call (only when options.record_analysis).
+  std::vector<WindowTrackRecord> takeWindowRecords();
   /// Events since the last call (moved out).
   std::vector<EstimatorEvent> takeEvents();
   /// Residual blocks and iterations of the last optimisation (diagnostics).
@@ -151,6 +169,7 @@ class Estimator {
   // Window states, W_ + 1 slots.
   std::vector<double> headers_;
   std::vector<int64_t> header_ns_;  // same, exact
+  std::vector<double> intensity_;   // mean image intensity per slot
   std::vector<Eigen::Vector3d> Ps_, Vs_, Bas_, Bgs_;
   std::vector<Eigen::Matrix3d> Rs_;
   std::vector<std::unique_ptr<ImuPreintegration>> preintegrations_;
@@ -198,6 +217,8 @@ class Estimator {
   Eigen::Vector3d bias_prior_bg_ = Eigen::Vector3d::Zero();
   int last_iterations_ = 0, last_point_residuals_ = 0, last_line_residuals_ = 0;
   std::vector<EstimatorEvent> events_;
+  std::vector<WindowTrackRecord> window_records_;
+  void recordWindow();
 };
 
 }  // namespace alvio

@@ -20,6 +20,8 @@ struct EstimatorOptions {
   double outlier_reprojection_px = 3.0;  ///< landmarks with a larger mean error are removed
   double imu_noise_scale = 1.0;          ///< multiplies every IMU noise density and random walk
 
+  bool record_analysis = false;  ///< keep WindowTrackRecords (alvio run --analysis)
+
   // Lines.
   bool use_lines = true;          ///< line landmarks in the optimisation
   double line_sigma_px = 1.5;     ///< endpoint-to-line noise of line observations

@@ -25,6 +25,8 @@ struct PipelineOutput {
   std::vector<EstimatorEvent> events;
   /// Lines that left the estimator's window on this frame, refined over their whole track.
   LineSegments3 retired_lines;
+  /// Sensitivity-analysis records of windows that slid on this frame (record_analysis).
+  std::vector<WindowTrackRecord> window_records;
 };
 
 class VioPipeline {
