@@ -34,6 +34,51 @@ ceres::LossFunction* makeLoss(const EstimatorOptions& o) {
 
 }  // namespace
 
+bool Estimator::pointSelected(const PointLandmark& l) const {
+  const FeatureSelectionOptions& o = options_.selection;
+  if (!o.select_points) return true;
+  const Eigen::Vector2d& px = l.sightings.front().px;
+  return o.point_surface.keep(px.x(), px.y());
+}
+
+bool Estimator::lineSelected(const LineLandmark& l) const {
+  const FeatureSelectionOptions& o = options_.selection;
+  if (!o.select_lines) return true;
+  // Midpoint of the first observation in the window, in the undistorted image.
+  const auto& first = l.observations.begin()->second;
+  const Eigen::Vector2d mid = 0.5 * (first.start_norm + first.end_norm);
+  return o.line_surface.keep(camera_.intrinsics[0] * mid.x() + camera_.intrinsics[2],
+                             camera_.intrinsics[1] * mid.y() + camera_.intrinsics[3]);
+}
+
+void Estimator::updateWeights() {
+  stats_ = OptimizationStats();
+  double track_p = 0, track_l = 0;
+  for (const auto& [id, l] : points_.landmarks()) {
+    if (!l.usable(W_)) continue;
+    ++stats_.points_tracked;
+    track_p += l.sightings.size();
+    stats_.points_used += pointSelected(l);
+  }
+  for (const auto& [id, l] : lines_.landmarks()) {
+    if (!options_.use_lines || !lines_.usable(l)) continue;
+    ++stats_.lines_tracked;
+    track_l += l.observations.size();
+    stats_.lines_used += lineSelected(l);
+  }
+  const double M_p = stats_.points_tracked ? track_p / stats_.points_tracked : 0;
+  const double M_l = stats_.lines_tracked ? track_l / stats_.lines_tracked : 0;
+  const FeatureWeights w = adaptiveWeights(M_p, M_l, options_.selection);
+  stats_.w_p = w.w_p;
+  stats_.w_l = w.w_l;
+  stats_.alpha = w.alpha;
+  stats_.M_p = M_p;
+  stats_.M_l = M_l;
+  // Residuals are scaled by 2w, so equal weights leave the visual terms unchanged.
+  point_scale_ = options_.selection.adaptive_weighting && options_.use_lines ? 2 * w.w_p : 1.0;
+  line_scale_ = options_.selection.adaptive_weighting && options_.use_lines ? 2 * w.w_l : 1.0;
+}
+
 void Estimator::statesToParameters() {
   for (int i = 0; i <= W_; ++i) {
     Eigen::Map<Eigen::Vector3d>{para_pose_[i].data()} = Ps_[i];
@@ -87,6 +132,7 @@ void Estimator::optimize(FrameTiming* timing, int max_iterations) {
     if (options_.use_lines) lines_.triangulate([this](int64_t ns) { return cameraPose(ns); });
   }
   ScopedStage stage(timing, "optimization");
+  updateWeights();
   statesToParameters();
   ceres::Problem::Options problem_options;
   problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
@@ -112,11 +158,12 @@ void Estimator::optimize(FrameTiming* timing, int max_iterations) {
                              para_pose_[i].data(), para_speed_bias_[i].data(), para_pose_[j].data(),
                              para_speed_bias_[j].data());
   }
-  const double sqrt_info = camera_.intrinsics[0] / options_.point_sigma_px;
+  const double sqrt_info = point_scale_ * camera_.intrinsics[0] / options_.point_sigma_px;
   int index = -1, residuals = 0;
   for (const auto& [id, l] : points_.landmarks()) {
     if (!l.usable(W_)) continue;
     ++index;
+    if (!pointSelected(l)) continue;
     const int i = l.start_frame;
     const Eigen::Vector2d obs_i = l.sightings.front().xy1.head<2>();
     for (std::size_t k = 1; k < l.sightings.size(); ++k) {
@@ -132,13 +179,14 @@ void Estimator::optimize(FrameTiming* timing, int max_iterations) {
   int line_residuals = 0;
   if (options_.use_lines) {
     auto* line_manifold = new OrthonormalLineManifold();  // owned by the problem
-    const double line_sqrt_info = camera_.intrinsics[0] / options_.line_sigma_px;
+    const double line_sqrt_info = line_scale_ * camera_.intrinsics[0] / options_.line_sigma_px;
     std::map<int64_t, int> slot;
     for (int i = 0; i <= frame_count_; ++i) slot[header_ns_[i]] = i;
     std::size_t k = 0;
     for (const auto& [id, l] : lines_.landmarks()) {
       if (!lines_.usable(l)) continue;
       double* line_block = para_line_[k++].data();
+      if (!lineSelected(l)) continue;
       problem.AddParameterBlock(line_block, OrthonormalLine::kParameterSize, line_manifold);
       for (const auto& [ns, obs] : l.observations) {
         problem.AddResidualBlock(
@@ -158,6 +206,9 @@ void Estimator::optimize(FrameTiming* timing, int max_iterations) {
   ceres::Solver::Summary summary;
   ceres::Solve(options, &problem, &summary);
   last_iterations_ = static_cast<int>(summary.iterations.size());
+  stats_.iterations = last_iterations_;
+  stats_.point_residuals = last_point_residuals_;
+  stats_.line_residuals = last_line_residuals_;
   parametersToStates();
   removeReprojectionOutliers();
   if (options_.use_lines) {
@@ -214,12 +265,12 @@ void Estimator::marginalize() {
                              {para_pose_[0].data(), para_speed_bias_[0].data(),
                               para_pose_[1].data(), para_speed_bias_[1].data()},
                              {0, 1});
-    const double sqrt_info = camera_.intrinsics[0] / options_.point_sigma_px;
+    const double sqrt_info = point_scale_ * camera_.intrinsics[0] / options_.point_sigma_px;
     int index = -1;
     for (const auto& [id, l] : points_.landmarks()) {
       if (!l.usable(W_)) continue;
       ++index;
-      if (l.start_frame != 0) continue;
+      if (l.start_frame != 0 || !pointSelected(l)) continue;
       const Eigen::Vector2d obs_i = l.sightings.front().xy1.head<2>();
       for (std::size_t k = 1; k < l.sightings.size(); ++k)
         info->addResidualBlock(
@@ -230,14 +281,14 @@ void Estimator::marginalize() {
     if (options_.use_lines) {
       // Lines first seen in the oldest frame leave the state with it, like points anchored
       // there: all their window observations go into the prior.
-      const double line_sqrt_info = camera_.intrinsics[0] / options_.line_sigma_px;
+      const double line_sqrt_info = line_scale_ * camera_.intrinsics[0] / options_.line_sigma_px;
       std::map<int64_t, int> slot;
       for (int i = 0; i <= frame_count_; ++i) slot[header_ns_[i]] = i;
       std::size_t k = 0;
       for (const auto& [id, l] : lines_.landmarks()) {
         if (!lines_.usable(l)) continue;
         double* line_block = para_line_[k++].data();
-        if (l.observations.begin()->first != header_ns_[0]) continue;
+        if (l.observations.begin()->first != header_ns_[0] || !lineSelected(l)) continue;
         for (const auto& [ns, obs] : l.observations)
           info->addResidualBlock(
               new LineProjectionFactor(obs.start_norm, obs.end_norm, T_b_c_, line_sqrt_info),

@@ -24,6 +24,7 @@ EstimatorOptions EstimatorOptions::load(const YamlReader& yaml, const std::strin
   o.line_min_observations = yaml.getInt(p + "line_min_observations", o.line_min_observations);
   o.line_outlier_px = yaml.getDouble(p + "line_outlier_px", o.line_outlier_px);
   o.line_triangulation = LineTriangulationOptions::load(yaml, p + "line_triangulation");
+  o.selection = FeatureSelectionOptions::load(yaml, p + "selection");
   o.init_min_parallax_px = yaml.getDouble(p + "init_min_parallax_px", o.init_min_parallax_px);
   o.init_min_correspondences =
       yaml.getInt(p + "init_min_correspondences", o.init_min_correspondences);

@@ -1,6 +1,7 @@
 #include "alvio/pipeline/offline_runner.h"
 
 #include <chrono>
+#include <cstdio>
 #include <deque>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -86,6 +87,10 @@ RunResult runOffline(SensorSource& source, const Config& config, const RunOption
   RunResult result;
   const auto gt = source.groundTruth();
   std::ostringstream events_log;
+  std::ostringstream frame_stats;
+  frame_stats
+      << "t,points,lines,points_tracked,lines_tracked,points_used,lines_used,point_residuals,"
+         "line_residuals,w_p,w_l,alpha,iterations\n";
   const std::size_t total = options.max_frames > 0
                                 ? std::min<std::size_t>(options.max_frames, source.imageCount())
                                 : source.imageCount();
@@ -125,6 +130,13 @@ RunResult runOffline(SensorSource& source, const Config& config, const RunOption
       }
     }
     if (out.has_pose) {
+      const OptimizationStats& o = out.optimization;
+      char row[256];
+      std::snprintf(row, sizeof(row), "%.6f,%zu,%zu,%d,%d,%d,%d,%d,%d,%.4f,%.4f,%.2f,%d\n",
+                    out.state.t, out.features.points.size(), out.features.lines.size(),
+                    o.points_tracked, o.lines_tracked, o.points_used, o.lines_used,
+                    o.point_residuals, o.line_residuals, o.w_p, o.w_l, o.alpha, o.iterations);
+      frame_stats << row;
       StampedPose p;
       p.t = out.state.t;
       p.p = out.state.p;
@@ -161,6 +173,7 @@ RunResult runOffline(SensorSource& source, const Config& config, const RunOption
   writeTumTrajectory((fs::path(options.out_dir) / "trajectory.tum").string(), result.trajectory);
   writeFileAtomically((fs::path(options.out_dir) / "timing.csv").string(), result.timing.toCsv());
   writeFileAtomically((fs::path(options.out_dir) / "events.log").string(), events_log.str());
+  writeFileAtomically((fs::path(options.out_dir) / "frame_stats.csv").string(), frame_stats.str());
 
   nlohmann::json summary;
   summary["dataset"] = source.description();

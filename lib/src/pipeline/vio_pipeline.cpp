@@ -26,7 +26,10 @@ PipelineOutput VioPipeline::addImage(const cv::Mat& gray, int64_t t_ns) {
   // After a reset the tracks start again, so re-initialisation sees fresh parallax.
   if (estimator_.resetCount() != resets_before) point_tracker_.reset();
   out.status = estimator_.status();
-  if (out.has_pose) out.state = estimator_.latestState();
+  if (out.has_pose) {
+    out.state = estimator_.latestState();
+    out.optimization = estimator_.lastOptimizationStats();
+  }
   out.events = estimator_.takeEvents();
   out.retired_lines = estimator_.takeRetiredLines();
   out.window_records = estimator_.takeWindowRecords();

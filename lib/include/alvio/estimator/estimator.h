@@ -71,6 +71,15 @@ struct WindowTrackRecord {
   std::vector<Feature> points, lines;
 };
 
+/// What the last optimisation used (diagnostics, the ablation and Fig. 8 plots).
+struct OptimizationStats {
+  int points_tracked = 0, lines_tracked = 0;  ///< usable landmarks in the window
+  int points_used = 0, lines_used = 0;        ///< after selection
+  int point_residuals = 0, line_residuals = 0;
+  double w_p = 0.5, w_l = 0.5, alpha = 1.0, M_p = 0, M_l = 0;
+  int iterations = 0;
+};
+
 /// Something a user should know about: initialisation, a reset, why it waits.
 struct EstimatorEvent {
   enum class Kind { kWaiting, kInitialized, kFailure, kReset };
@@ -115,6 +124,7 @@ class Estimator {
   int lastIterations() const { return last_iterations_; }
   int lastPointResiduals() const { return last_point_residuals_; }
   int lastLineResiduals() const { return last_line_residuals_; }
+  const OptimizationStats& lastOptimizationStats() const { return stats_; }
   const PointLandmarks& points() const { return points_; }
   const LineLandmarks& lines() const { return lines_; }
 
@@ -148,6 +158,10 @@ class Estimator {
   void removeReprojectionOutliers();
   void removeLineOutliers();
   void updateLineUncertainty();
+  // Selection and weights (feature_selection.h), fixed per frame by updateWeights().
+  bool pointSelected(const PointLandmark& l) const;
+  bool lineSelected(const LineLandmark& l) const;
+  void updateWeights();
   Eigen::Isometry3d cameraPose(int64_t frame_ns) const;  // T_w_c of a window frame
 
   // estimator_initialization.cpp
@@ -216,6 +230,8 @@ class Estimator {
   bool bias_prior_pending_ = false;  // the initialisation bias prior is not yet marginalised
   Eigen::Vector3d bias_prior_bg_ = Eigen::Vector3d::Zero();
   int last_iterations_ = 0, last_point_residuals_ = 0, last_line_residuals_ = 0;
+  OptimizationStats stats_;
+  double point_scale_ = 1.0, line_scale_ = 1.0;  // residual scales from the adaptive weights
   std::vector<EstimatorEvent> events_;
   std::vector<WindowTrackRecord> window_records_;
   void recordWindow();

@@ -3,6 +3,7 @@
 
 #include <string>
 
+#include "alvio/estimator/feature_selection.h"
 #include "alvio/geometry/line_triangulation.h"
 
 namespace alvio {
@@ -28,6 +29,9 @@ struct EstimatorOptions {
   int line_min_observations = 3;  ///< window observations before a line is used
   double line_outlier_px = 5.0;   ///< lines with a larger mean endpoint error are removed
   LineTriangulationOptions line_triangulation;
+
+  /// Sensitivity-based selection and adaptive weighting (estimator.selection).
+  FeatureSelectionOptions selection;
 
   // Initialisation.
   double init_min_parallax_px = 80;  ///< rotation-compensated, reference frame to newest

@@ -4,6 +4,7 @@
 //   trajectory.tum   body pose T_w_b at every frame after initialisation (TUM)
 //   timing.csv       per-frame stage times (ms)
 //   events.log       initialisation, waiting reasons, failures and resets
+//   frame_stats.csv  per frame: features tracked/used, residuals, adaptive weights
 //   summary.json     counts, timing summary, initialisation quality and ATE
 // and, when the dataset has ground truth, prints the ATE.
 

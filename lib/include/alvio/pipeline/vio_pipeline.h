@@ -27,6 +27,8 @@ struct PipelineOutput {
   LineSegments3 retired_lines;
   /// Sensitivity-analysis records of windows that slid on this frame (record_analysis).
   std::vector<WindowTrackRecord> window_records;
+  /// What the optimisation of this frame used (valid when has_pose).
+  OptimizationStats optimization;
 };
 
 class VioPipeline {

@@ -1,0 +1,58 @@
+#pragma once
+// Sensitivity-analysis-based feature selection and adaptive weighting (ALVIO,
+// Sec. 3). A fitted surface gives the expected track length of a feature from
+// its image position; features where it is below a level are left out of the
+// optimisation. Points and lines are weighted by how long each kind tracks:
+//   w_p = M_p / (a M_l + M_p),  w_l = a M_l / (a M_l + M_p),
+// with a = alpha_more, alpha_similar or alpha_less when lines track more than,
+// about as long as, or less than points.
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace alvio {
+
+class YamlReader;
+
+/// Expected track length over the image: a bivariate polynomial in
+/// (u, v) = (x / width - 0.5, y / height - 0.5), monomials u^i v^j with i + j <= degree in
+/// order of total degree, then increasing j (as scripts/analyze_sensitivity.py writes it).
+struct TrackSurface {
+  int degree = 0;
+  double width = 752, height = 480;
+  std::vector<double> coefficients;
+  double min_expected_track = 0;  ///< the selection level
+  bool valid() const { return !coefficients.empty(); }
+  double expected(double x, double y) const;
+  bool keep(double x, double y) const { return !valid() || expected(x, y) >= min_expected_track; }
+};
+
+struct FeatureSelectionOptions {
+  bool select_points = false;  ///< leave points in low-value image regions out
+  bool select_lines = false;
+  std::string surfaces_file;  ///< selection_surfaces.yaml (alvio analyze); relative to the config
+  TrackSurface point_surface, line_surface;  ///< loaded from surfaces_file
+  bool adaptive_weighting = false;
+  double alpha_more = 5.0;     ///< lines track longer than points
+  double alpha_similar = 2.2;  ///< about as long
+  double alpha_less = 1.0;     ///< shorter
+  double similar_band = 0.2;   ///< |M_l - M_p| <= band * max(M_l, M_p) counts as "about as long"
+
+  /// Reads `prefix` ("estimator.selection"); a relative surfaces_file is resolved against the
+  /// directory of the config file and loaded (errors name that file and key).
+  static FeatureSelectionOptions load(const YamlReader& yaml, const std::string& prefix);
+};
+
+/// Loads a selection_surfaces.yaml.
+void loadTrackSurfaces(const std::string& path, TrackSurface* points, TrackSurface* lines);
+
+struct FeatureWeights {
+  double w_p = 0.5, w_l = 0.5, alpha = 1.0;
+  double M_p = 0, M_l = 0;  ///< mean track counts in the window
+};
+
+/// The ALVIO weights for mean track counts M_p and M_l.
+FeatureWeights adaptiveWeights(double M_p, double M_l, const FeatureSelectionOptions& options);
+
+}  // namespace alvio

@@ -1,0 +1,83 @@
+#include "alvio/estimator/feature_selection.h"
+
+#include <cmath>
+#include <filesystem>
+
+#include "alvio/common/error.h"
+#include "alvio/config/yaml_reader.h"
+
+namespace alvio {
+
+double TrackSurface::expected(double x, double y) const {
+  const double u = x / width - 0.5, v = y / height - 0.5;
+  double sum = 0;
+  std::size_t k = 0;
+  for (int total = 0; total <= degree; ++total)
+    for (int j = 0; j <= total; ++j)
+      sum += coefficients[k++] * std::pow(u, total - j) * std::pow(v, j);
+  return sum;
+}
+
+void loadTrackSurfaces(const std::string& path, TrackSurface* points, TrackSurface* lines) {
+  YamlReader yaml(path);
+  const int degree = yaml.getInt("degree");
+  if (degree < 0 || degree > 8) throw Error(yaml.where("degree") + " must be in 0..8");
+  const std::size_t n = static_cast<std::size_t>((degree + 1) * (degree + 2) / 2);
+  for (auto [key, surface] : {std::make_pair("points", points), std::make_pair("lines", lines)}) {
+    surface->coefficients.clear();
+    if (!yaml.has(key)) continue;
+    surface->degree = degree;
+    surface->width = yaml.getDouble("width");
+    surface->height = yaml.getDouble("height");
+    surface->coefficients =
+        yaml.getDoubles(std::string(key) + ".coefficients", static_cast<int>(n));
+    surface->min_expected_track = yaml.getDouble(std::string(key) + ".min_expected_track");
+  }
+  yaml.warnUnknownKeys();
+}
+
+FeatureSelectionOptions FeatureSelectionOptions::load(const YamlReader& yaml,
+                                                      const std::string& prefix) {
+  FeatureSelectionOptions o;
+  const std::string p = prefix + ".";
+  o.select_points = yaml.getBool(p + "points", o.select_points);
+  o.select_lines = yaml.getBool(p + "lines", o.select_lines);
+  o.surfaces_file = yaml.getString(p + "surfaces_file", o.surfaces_file);
+  o.adaptive_weighting = yaml.getBool(p + "adaptive_weighting", o.adaptive_weighting);
+  o.alpha_more = yaml.getDouble(p + "alpha_more", o.alpha_more);
+  o.alpha_similar = yaml.getDouble(p + "alpha_similar", o.alpha_similar);
+  o.alpha_less = yaml.getDouble(p + "alpha_less", o.alpha_less);
+  o.similar_band = yaml.getDouble(p + "similar_band", o.similar_band);
+  for (const char* k : {"alpha_more", "alpha_similar", "alpha_less"})
+    if (yaml.getDouble(p + k, 1.0) <= 0) throw Error(yaml.where(p + k) + " must be positive");
+  if (o.similar_band < 0) throw Error(yaml.where(p + "similar_band") + " must not be negative");
+  if (!o.surfaces_file.empty()) {
+    namespace fs = std::filesystem;
+    fs::path file(o.surfaces_file);
+    if (file.is_relative()) file = fs::path(yaml.path()).parent_path() / file;
+    if (!fs::exists(file))
+      throw Error(yaml.where(p + "surfaces_file") + ": '" + file.string() + "' does not exist");
+    o.surfaces_file = file.string();
+    loadTrackSurfaces(o.surfaces_file, &o.point_surface, &o.line_surface);
+  }
+  if ((o.select_points && !o.point_surface.valid()) || (o.select_lines && !o.line_surface.valid()))
+    throw Error(yaml.where(p + "surfaces_file") +
+                " must name a selection_surfaces.yaml with the selected kinds (alvio analyze)");
+  return o;
+}
+
+FeatureWeights adaptiveWeights(double M_p, double M_l, const FeatureSelectionOptions& o) {
+  FeatureWeights w;
+  w.M_p = M_p;
+  w.M_l = M_l;
+  if (M_p <= 0 && M_l <= 0) return w;
+  const double band = o.similar_band * std::max(M_p, M_l);
+  w.alpha =
+      std::abs(M_l - M_p) <= band ? o.alpha_similar : (M_l > M_p ? o.alpha_more : o.alpha_less);
+  const double denominator = w.alpha * M_l + M_p;
+  w.w_p = M_p / denominator;
+  w.w_l = w.alpha * M_l / denominator;
+  return w;
+}
+
+}  // namespace alvio
