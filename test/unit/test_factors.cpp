@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
 #include <random>
 
 #include "alvio/common/rotation.h"
@@ -171,4 +172,62 @@ TEST(Marginalization, PriorIgnoresQuaternionSign) {
   prior.Evaluate(params, r2.data(), nullptr);
   EXPECT_LT((r1 - r2).norm(), 1e-12);
   EXPECT_LT(test::checkJacobians(prior, {pose1, pose2}).max_rel_error, 1e-6);
+}
+
+// The prior's information equals the dense Schur complement of the full system.
+TEST(Marginalization, PriorEqualsDenseSchurComplement) {
+  const Eigen::Isometry3d T_b_c = eurocTbc();
+  double poses[3][7], depths[4][1];
+  for (int k = 0; k < 3; ++k)
+    setPose(poses[k], Eigen::Vector3d(0.2 * k, 0.05 * k, 0.02 * k),
+            expQuaternion(Eigen::Vector3d(0.01 * k, 0.03 * k, -0.02 * k)));
+  const Eigen::Vector2d obs[4] = {{0.1, 0.05}, {-0.2, 0.1}, {0.05, -0.15}, {0.3, 0.2}};
+  struct F {
+    std::unique_ptr<PointProjectionFactor> f;
+    int pose_j, depth;
+  };
+  std::vector<F> factors;
+  auto info = std::make_shared<MarginalizationInfo>();
+  for (int l = 0; l < 4; ++l) {
+    depths[l][0] = 0.2 + 0.05 * l;
+    for (int j = 1; j < 3; ++j) {
+      const Eigen::Vector2d o_j = obs[l] + Eigen::Vector2d(0.01 * j, -0.02 * j);
+      factors.push_back({std::make_unique<PointProjectionFactor>(obs[l], o_j, T_b_c, 50.0), j, l});
+      info->addResidualBlock(new PointProjectionFactor(obs[l], o_j, T_b_c, 50.0), nullptr,
+                             {poses[0], poses[j], depths[l]}, {0, 2});
+    }
+  }
+  ASSERT_TRUE(info->marginalize());
+  // Dense system in tangent space: [pose0 (6), depths (4), pose1 (6), pose2 (6)].
+  const int N = 6 + 4 + 12;
+  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(N, N);
+  Eigen::VectorXd g = Eigen::VectorXd::Zero(N);
+  for (const auto& fa : factors) {
+    const double* params[] = {poses[0], poses[fa.pose_j], depths[fa.depth]};
+    Eigen::Vector2d r;
+    Eigen::Matrix<double, 2, 7, Eigen::RowMajor> J0, J1;
+    Eigen::Vector2d Jd;
+    double* jac[] = {J0.data(), J1.data(), Jd.data()};
+    fa.f->Evaluate(params, r.data(), jac);
+    Eigen::MatrixXd J = Eigen::MatrixXd::Zero(2, N);
+    J.block(0, 0, 2, 6) = J0 * posePlusJacobian(poses[0]);
+    J.block(0, 6 + fa.depth, 2, 1) = Jd;
+    J.block(0, 10 + 6 * (fa.pose_j - 1), 2, 6) = J1 * posePlusJacobian(poses[fa.pose_j]);
+    H += J.transpose() * J;
+    g += J.transpose() * r;
+  }
+  const int m = 10, n = 12;
+  const Eigen::MatrixXd Hmm = H.topLeftCorner(m, m);
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(Hmm);
+  const Eigen::VectorXd inv =
+      (es.eigenvalues().array() > 1e-8).select(es.eigenvalues().array().inverse(), 0.0);
+  const Eigen::MatrixXd Hmm_inv =
+      es.eigenvectors() * inv.asDiagonal() * es.eigenvectors().transpose();
+  const Eigen::MatrixXd Hrr =
+      H.bottomRightCorner(n, n) - H.bottomLeftCorner(n, m) * Hmm_inv * H.topRightCorner(m, n);
+  const Eigen::VectorXd gr = g.tail(n) - H.bottomLeftCorner(n, m) * Hmm_inv * g.head(m);
+  const Eigen::MatrixXd& Jp = info->linearizedJacobian();
+  ASSERT_EQ(info->keptAddresses(), (std::vector<double*>{poses[1], poses[2]}));
+  EXPECT_LT((Jp.transpose() * Jp - Hrr).norm() / Hrr.norm(), 1e-8);
+  EXPECT_LT((Jp.transpose() * info->linearizedResidual() - gr).norm() / gr.norm(), 1e-8);
 }

@@ -94,9 +94,17 @@ bool MarginalizationInfo::marginalize() {
       auto& list = is_dropped.count(b) ? dropped : kept;
       if (std::find(list.begin(), list.end(), b) == list.end()) list.push_back(b);
     }
+  // Landmark blocks (inverse depths, lines: size 1 or 4) first: they couple only with the
+  // states, never with each other, so they are eliminated one by one below.
+  std::stable_partition(dropped.begin(), dropped.end(),
+                        [&](double* b) { return size_of[b] == 1 || size_of[b] == 4; });
   std::unordered_map<double*, int> offset;
-  int m = 0, n = 0;
-  for (double* b : dropped) offset[b] = m, m += tangentSizeOf(size_of[b]);
+  int m = 0, n = 0, m_landmarks = 0;
+  for (double* b : dropped) {
+    offset[b] = m;
+    m += tangentSizeOf(size_of[b]);
+    if (size_of[b] == 1 || size_of[b] == 4) m_landmarks = m;
+  }
   for (double* b : kept) offset[b] = m + n, n += tangentSizeOf(size_of[b]);
   if (n == 0) return false;
 
@@ -132,19 +140,35 @@ bool MarginalizationInfo::marginalize() {
     }
   }
 
-  // Schur complement onto the kept states, with a pseudo-inverse of the dropped block.
-  Eigen::MatrixXd Hrr = H.bottomRightCorner(n, n);
-  Eigen::VectorXd gr = g.tail(n);
-  if (m > 0) {
-    const Eigen::MatrixXd Hmm = 0.5 * (H.topLeftCorner(m, m) + H.topLeftCorner(m, m).transpose());
-    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(Hmm);
+  // Schur complement onto the kept states. Landmarks go first, block by block (their blocks
+  // are tiny and mutually independent), then the remaining dropped states densely; both
+  // with pseudo-inverses, as a landmark can be unconstrained in some direction.
+  auto pseudoInverse = [](const Eigen::MatrixXd& A) {
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(0.5 * (A + A.transpose()));
     const Eigen::VectorXd inv =
         (es.eigenvalues().array() > 1e-8).select(es.eigenvalues().array().inverse(), 0.0);
+    return Eigen::MatrixXd(es.eigenvectors() * inv.asDiagonal() * es.eigenvectors().transpose());
+  };
+  const int total = m + n;
+  for (double* b : dropped) {
+    const int o = offset[b], t = tangentSizeOf(size_of[b]);
+    if (o >= m_landmarks) break;
+    const Eigen::MatrixXd inv = pseudoInverse(H.block(o, o, t, t));
+    const int rest = total - m_landmarks;  // eliminate into the states and kept blocks only
+    const Eigen::MatrixXd Hxl = H.block(m_landmarks, o, rest, t);
+    const Eigen::MatrixXd K = Hxl * inv;
+    H.bottomRightCorner(rest, rest).noalias() -= K * Hxl.transpose();
+    g.tail(rest).noalias() -= K * g.segment(o, t);
+  }
+  Eigen::MatrixXd Hrr = H.bottomRightCorner(n, n);
+  Eigen::VectorXd gr = g.tail(n);
+  const int m_states = m - m_landmarks;
+  if (m_states > 0) {
     const Eigen::MatrixXd Hmm_inv =
-        es.eigenvectors() * inv.asDiagonal() * es.eigenvectors().transpose();
-    const Eigen::MatrixXd Hrm = H.bottomLeftCorner(n, m);
-    Hrr -= Hrm * Hmm_inv * H.topRightCorner(m, n);
-    gr -= Hrm * Hmm_inv * g.head(m);
+        pseudoInverse(H.block(m_landmarks, m_landmarks, m_states, m_states));
+    const Eigen::MatrixXd Hrm = H.block(m, m_landmarks, n, m_states);
+    Hrr -= Hrm * Hmm_inv * Hrm.transpose();
+    gr -= Hrm * Hmm_inv * g.segment(m_landmarks, m_states);
   }
 
   // Factor the prior as |J dx + r|^2: Hrr = J^T J, gr = J^T r.
