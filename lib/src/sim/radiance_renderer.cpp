@@ -1,0 +1,215 @@
+#include "alvio/sim/radiance_renderer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <thread>
+#include <vector>
+
+#include "alvio/common/error.h"
+
+namespace alvio::sim {
+namespace {
+
+// f(k) for k in [0, n) over `threads` threads, interleaved (deterministic output).
+template <typename F>
+void parallelFor(int n, int threads, F&& f) {
+  threads = std::max(1, std::min(threads, n));
+  std::vector<std::thread> pool;
+  for (int k = 1; k < threads; ++k)
+    pool.emplace_back([&, k] {
+      for (int i = k; i < n; i += threads) f(i);
+    });
+  for (int i = 0; i < n; i += threads) f(i);
+  for (auto& t : pool) t.join();
+}
+
+}  // namespace
+
+RadianceRenderer::RadianceRenderer(const Scene& scene, const SceneAppearance& appearance,
+                                   const CameraRayTable& rays)
+    : scene_(scene), appearance_(appearance), rays_(rays) {
+  if (!scene.finalized()) throw Error("RadianceRenderer: the scene is not finalized");
+  const int w = rays.width(), h = rays.height();
+  tiles_x_ = (w + kTile - 1) / kTile;
+  tiles_y_ = (h + kTile - 1) / kTile;
+  for (int ty = 0; ty < tiles_y_; ++ty)
+    for (int tx = 0; tx < tiles_x_; ++tx) {
+      Tile t;
+      t.u0 = tx * kTile;
+      t.v0 = ty * kTile;
+      t.u1 = std::min(w, t.u0 + kTile);
+      t.v1 = std::min(h, t.v0 + kTile);
+      // Corner rays at the tile's outer pixel borders, clockwise in the image.
+      const float x0 = t.u0 - 0.5f, x1 = t.u1 - 0.5f, y0 = t.v0 - 0.5f, y1 = t.v1 - 0.5f;
+      const Eigen::Vector3f c[4] = {rays.ray(x0, y0), rays.ray(x1, y0), rays.ray(x1, y1),
+                                    rays.ray(x0, y1)};
+      const Eigen::Vector3f centre = (c[0] + c[1] + c[2] + c[3]).normalized();
+      for (int k = 0; k < 4; ++k) {
+        Eigen::Vector3f n = c[k].cross(c[(k + 1) % 4]).normalized();
+        if (n.dot(centre) < 0) n = -n;
+        t.normal_c[k] = n;
+      }
+      // Lens distortion bends the tile borders slightly: measure how far any ray of
+      // the tile (pixel centres, corners, and the midpoints between) falls outside.
+      float worst = 0;
+      for (int j = 2 * t.v0; j <= 2 * t.v1; ++j)
+        for (int i = 2 * t.u0; i <= 2 * t.u1; ++i) {
+          const Eigen::Vector3f r = rays.ray(-0.5f + 0.5f * i, -0.5f + 0.5f * j);
+          for (int k = 0; k < 4; ++k) worst = std::max(worst, -t.normal_c[k].dot(r));
+        }
+      t.slack = worst + 1e-4f;
+      tiles_.push_back(t);
+    }
+}
+
+void RadianceRenderer::cullTile(const Tile& tile, const Eigen::Matrix3f& R,
+                                const Eigen::Vector3f& o, std::vector<Candidate>* out) const {
+  Eigen::Vector3f n[4];
+  for (int k = 0; k < 4; ++k) n[k] = R * tile.normal_c[k];
+  const float slack = tile.slack;
+  // A box is outside if, for some plane, even its most inward corner is outside by
+  // more than the slack allows at its distance.
+  auto accept = [&](const float* lo, const float* hi) {
+    const Eigen::Vector3f blo(lo[0], lo[1], lo[2]), bhi(hi[0], hi[1], hi[2]);
+    const float reach = ((0.5f * (blo + bhi) - o).norm() + 0.5f * (bhi - blo).norm()) * slack;
+    for (int k = 0; k < 4; ++k) {
+      const Eigen::Vector3f p(n[k].x() > 0 ? bhi.x() : blo.x(), n[k].y() > 0 ? bhi.y() : blo.y(),
+                              n[k].z() > 0 ? bhi.z() : blo.z());
+      if (n[k].dot(p - o) < -reach) return false;
+    }
+    return true;
+  };
+  const auto& quads = scene_.fastQuads();
+  out->clear();
+  scene_.bvh().traverseIf(accept, [&](int qi) {
+    const Scene::FastQuad& q = quads[qi];
+    const float side = q.normal.dot(o - q.origin);
+    if (!q.two_sided && side <= 0) return;  // its back faces the camera: never hit
+    const Eigen::Vector3f eu = q.u_scaled * (q.length_u * q.length_u);
+    const Eigen::Vector3f ev = q.v_scaled * (q.length_v * q.length_v);
+    const Eigen::Vector3f corner[4] = {q.origin, q.origin + eu, q.origin + eu + ev, q.origin + ev};
+    for (int k = 0; k < 4; ++k) {
+      bool all_out = true;
+      for (const auto& c : corner)
+        if (n[k].dot(c - o) >= -slack * (c - o).norm()) {
+          all_out = false;
+          break;
+        }
+      if (all_out) return;
+    }
+    // Nearest possible distance: to the quad's plane, and to its bounding box.
+    Eigen::Vector3f lo = corner[0], hi = corner[0];
+    for (int i = 1; i < 4; ++i) {
+      lo = lo.cwiseMin(corner[i]);
+      hi = hi.cwiseMax(corner[i]);
+    }
+    const float box = (o.cwiseMax(lo).cwiseMin(hi) - o).norm();
+    out->push_back({std::max(std::abs(side), box) * 0.999f - 1e-4f, qi});
+  });
+  std::sort(out->begin(), out->end(), [](const Candidate& a, const Candidate& b) {
+    return a.min_distance < b.min_distance || (a.min_distance == b.min_distance && a.quad < b.quad);
+  });
+}
+
+float RadianceRenderer::shade(int quad, const Eigen::Vector3f& dir, float t, float a, float b,
+                              float pixel_angle) const {
+  const Scene::FastQuad& q = scene_.fastQuads()[quad];
+  const SceneAppearance::Mapping& m = appearance_.mapping(quad);
+  const float am = a * q.length_u, bm = b * q.length_v;
+  const float x = ((m.swap ? bm : am) + m.offset_x) * m.inv_texel;
+  const float y = ((m.swap ? q.length_u - am : q.length_v - bm) + m.offset_y) * m.inv_texel;
+  const float facing = q.normal.dot(dir);
+  // Footprint of the pixel on the surface, in texels (stretched by the slant).
+  const float slant = std::sqrt(std::max(std::abs(facing), 0.02f));
+  const float footprint = t * pixel_angle * m.inv_texel / slant;
+  const float albedo = appearance_.texture(m.texture).sample(x, y, footprint);
+  if (m.emissive > 0) return m.emissive * albedo;
+  const bool back = q.two_sided && facing > 0;
+  return albedo * appearance_.lightMap(quad).irradiance(back, a, b);
+}
+
+RadianceRenderer::Hit RadianceRenderer::trace(const std::vector<Candidate>& candidates,
+                                              const Eigen::Vector3f& origin,
+                                              const Eigen::Vector3f& dir, float pixel_angle) const {
+  const auto& quads = scene_.fastQuads();
+  float t = 1e30f, a = 0, b = 0;
+  int best = -1;
+  for (const Candidate& c : candidates) {
+    if (c.min_distance >= t) break;  // nothing further down the list can be nearer
+    float qa, qb;
+    if (Scene::intersectFast(quads[c.quad], origin, dir, &t, &qa, &qb)) {
+      best = c.quad;
+      a = qa;
+      b = qb;
+    }
+  }
+  if (best < 0) return {-1, 0.0f};
+  return {best, shade(best, dir, t, a, b, pixel_angle)};
+}
+
+cv::Mat1f RadianceRenderer::render(const Eigen::Isometry3d& T_w_c, const RenderOptions& options,
+                                   cv::Mat1i* quad_ids) const {
+  const int w = rays_.width(), h = rays_.height();
+  const int threads = std::max(1, options.threads);
+  const Eigen::Matrix3f R = T_w_c.linear().cast<float>();
+  const Eigen::Vector3f origin = T_w_c.translation().cast<float>();
+  cv::Mat1f image(h, w);
+  cv::Mat1i ids(h, w);
+  std::vector<std::vector<Candidate>> candidates(tiles_.size());
+
+  // Pass 1: one ray per pixel centre, tile by tile (a tile row per task).
+  parallelFor(tiles_y_, threads, [&](int ty) {
+    for (int tx = 0; tx < tiles_x_; ++tx) {
+      const int ti = ty * tiles_x_ + tx;
+      const Tile& tile = tiles_[ti];
+      cullTile(tile, R, origin, &candidates[ti]);
+      for (int v = tile.v0; v < tile.v1; ++v) {
+        float* out = image.ptr<float>(v);
+        int* id = ids.ptr<int>(v);
+        for (int u = tile.u0; u < tile.u1; ++u) {
+          const Hit s =
+              trace(candidates[ti], origin, R * rays_.centerRay(u, v), rays_.pixelAngle(u, v));
+          out[u] = s.value;
+          id[u] = s.quad;
+        }
+      }
+    }
+  });
+
+  // Pass 2: pixels on a geometric edge get n x n sub-pixel rays.
+  const int n = std::max(1, options.edge_samples);
+  if (n > 1) {
+    cv::Mat1f refined = image.clone();
+    parallelFor(tiles_y_, threads, [&](int ty) {
+      for (int tx = 0; tx < tiles_x_; ++tx) {
+        const int ti = ty * tiles_x_ + tx;
+        const Tile& tile = tiles_[ti];
+        for (int v = tile.v0; v < tile.v1; ++v) {
+          const int* row = ids.ptr<int>(v);
+          const int* up = ids.ptr<int>(std::max(v - 1, 0));
+          const int* down = ids.ptr<int>(std::min(v + 1, h - 1));
+          float* out = refined.ptr<float>(v);
+          for (int u = tile.u0; u < tile.u1; ++u) {
+            const int c = row[u];
+            if (row[std::max(u - 1, 0)] == c && row[std::min(u + 1, w - 1)] == c && up[u] == c &&
+                down[u] == c)
+              continue;
+            const float angle = rays_.pixelAngle(u, v) / n;
+            float sum = 0;
+            for (int j = 0; j < n; ++j)
+              for (int i = 0; i < n; ++i) {
+                const float x = u - 0.5f + (i + 0.5f) / n, y = v - 0.5f + (j + 0.5f) / n;
+                sum += trace(candidates[ti], origin, R * rays_.ray(x, y), angle).value;
+              }
+            out[u] = sum / (n * n);
+          }
+        }
+      }
+    });
+    image = refined;
+  }
+  if (quad_ids) *quad_ids = ids;
+  return image;
+}
+
+}  // namespace alvio::sim
