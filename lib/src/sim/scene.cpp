@@ -199,11 +199,25 @@ bool Scene::isVisible(const Eigen::Vector3d& point, const Eigen::Vector3d& from,
   return !intersect(from, d / dist, dist - tolerance_m).has_value();
 }
 
-double Scene::clearance(const Eigen::Vector3d& p) const {
+double Scene::clearance(const Eigen::Vector3d& p, int* object) const {
   double best = std::numeric_limits<double>::max();
-  for (const SceneSolid& s : solids_) best = std::min(best, boxDistance(s, p));
-  for (const SceneQuad& q : quads_)
-    if (q.two_sided) best = std::min(best, quadDistance(q, p));
+  int nearest = -1;
+  for (const SceneSolid& s : solids_) {
+    const double d = boxDistance(s, p);
+    if (d < best) {
+      best = d;
+      nearest = s.object;
+    }
+  }
+  for (const SceneQuad& q : quads_) {
+    if (!q.two_sided) continue;
+    const double d = quadDistance(q, p);
+    if (d < best) {
+      best = d;
+      nearest = q.object;
+    }
+  }
+  if (object) *object = nearest;
   return best;
 }
 

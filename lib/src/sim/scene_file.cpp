@@ -396,10 +396,15 @@ SceneFile parseRoot(const YAML::Node& root, const std::string& name) {
   const YAML::Node objects = top.raw("objects");
   if (!objects.IsSequence()) top.fail("objects", "must be a list");
   for (std::size_t i = 0; i < objects.size(); ++i) {
+    const YAML::Node item = objects[i];
     std::string where = name + ": objects[" + std::to_string(i) + "]";
-    if (objects[i].IsMap() && objects[i]["name"].IsScalar())
-      where += " ('" + objects[i]["name"].Scalar() + "')";
-    const Node o(objects[i], where);
+    if (item.IsMap()) {
+      const YAML::Node& map = item;
+      const YAML::Node object_name = map["name"];
+      if (object_name.IsDefined() && object_name.IsScalar())
+        where += " ('" + object_name.Scalar() + "')";
+    }
+    const Node o(item, where);
     int count = 1;
     Eigen::Vector3d step = Eigen::Vector3d::Zero();
     if (o.has("repeat")) {

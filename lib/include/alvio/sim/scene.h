@@ -116,8 +116,9 @@ class Scene {
   /// a surface or an edge; `tolerance_m` is the slack at the point's end).
   bool isVisible(const Eigen::Vector3d& point, const Eigen::Vector3d& from,
                  double tolerance_m = 1e-3) const;
-  /// Distance from `p` to the nearest solid or quad (negative inside a solid).
-  double clearance(const Eigen::Vector3d& p) const;
+  /// Distance from `p` to the nearest solid or two-sided quad (negative inside a
+  /// solid); `object` (optional) receives the index of that object.
+  double clearance(const Eigen::Vector3d& p, int* object = nullptr) const;
 
   // --- for the renderer: the precomputed single-precision quad data and the BVH.
   struct FastQuad {
