@@ -6,17 +6,25 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <ctime>
 #include <filesystem>
 #include <iostream>
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
+#include <thread>
 
 #include "alvio/common/arg_parser.h"
 #include "alvio/common/error.h"
 #include "alvio/common/logging.h"
 #include "alvio/common/progress_bar.h"
 #include "alvio/io/euroc_dataset.h"
+#include "alvio/io/trajectory_io.h"
 #include "alvio/sim/benchmark_set.h"
+#include "alvio/sim/euroc_sequences.h"
+#include "alvio/sim/pose_spline_fit.h"
+#include "alvio/sim/procedural_trajectories.h"
 #include "alvio/sim/scene_appearance.h"
 #include "alvio/sim/scene_file.h"
 #include "alvio/sim/sequence_generator.h"
@@ -81,6 +89,64 @@ void writeBag(const std::string& folder, const std::string& bag_path, const Topi
   fs::rename(bag_path + ".tmp", bag_path);
 }
 
+double cpuSeconds() {
+  return static_cast<double>(std::clock()) / CLOCKS_PER_SEC;
+}
+
+// Frames/s of the renderer alone (no PNG, no disk): frames spread over the trajectory,
+// rendered one at a time with all threads inside a frame, and frame-parallel.
+void measureSpeed(const SequenceOptions& o, int frames) {
+  const SceneFile scene = loadSceneFile(o.scene.empty() ? defaultScenePath() : o.scene);
+  AppearanceOptions ao;
+  ao.texture_density = parseTextureDensity(o.texture);
+  ao.threads = 2;
+  auto t0 = std::chrono::steady_clock::now();
+  const SceneAppearance appearance(scene.scene, ao);
+  const double appearance_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  Trajectory all;
+  if (isProceduralTrajectoryName(o.trajectory)) {
+    ProceduralPathOptions pp;
+    pp.duration_s = 60;
+    pp.T_b_c = o.config.camera.T_b_c;
+    pp.figure_eight = scene.figure_eight;
+    pp.corridor = scene.corridor;
+    all = makeProceduralTrajectory(o.trajectory, pp);
+  } else {
+    const auto euroc = findEurocSequence(o.trajectory);
+    all = readTrajectory(euroc ? euroc->ground_truth : o.trajectory);
+  }
+  const PoseSpline spline = fitPoseSpline(all, o.fit);
+  const auto camera = CameraModel::create(o.config.camera);
+  std::cout << "scene " << scene.scene.name << ": " << scene.scene.quads().size() << " quads, "
+            << "textures and light maps built in " << appearance_s << " s\n";
+  for (int threads : {1, 2}) {
+    CameraSimulationOptions co = o.camera;
+    co.render.threads = 1;
+    co.illumination = o.illumination;
+    CameraSimulator sim(scene.scene, appearance, *camera, o.config.camera.T_b_c, co);
+    sim.setExposureFromView(spline, spline.startTime() + 1);
+    std::vector<double> times;
+    const double span = spline.endTime() - spline.startTime() - 2;
+    for (int i = 0; i < frames; ++i)
+      times.push_back(spline.startTime() + 1 + span * (i + 0.5) / frames);
+    std::atomic<int> next{0};
+    const double c0 = cpuSeconds();
+    t0 = std::chrono::steady_clock::now();
+    std::vector<std::thread> pool;
+    for (int k = 0; k < threads; ++k)
+      pool.emplace_back([&] {
+        for (int i; (i = next++) < frames;) sim.render(spline, times[i], times[i] - times[0]);
+      });
+    for (auto& t : pool) t.join();
+    const double wall =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const double cpu = cpuSeconds() - c0;
+    std::cout << "threads " << threads << ": " << frames / wall << " frames/s (wall), "
+              << 1000 * cpu / frames << " ms CPU per frame\n";
+  }
+}
+
 std::vector<std::string> splitList(const std::string& text) {
   std::vector<std::string> out;
   std::stringstream ss(text);
@@ -132,6 +198,9 @@ int main(int argc, char** argv) {
   args.flag("force", "with --benchmark: rebuild even if up to date");
   args.option("demo", "write the demo sequence (30 s figure eight, machine hall) into this folder");
   args.option("preview", "render one frame at --start into this PNG and exit");
+  args.option("measure-speed",
+              "render this many frames along --trajectory (no output) with 1 and 2 threads and "
+              "report frames/s and CPU time per frame");
   args.flag("quiet", "no progress output");
   try {
     if (!args.parse(argc, argv)) return 0;
@@ -184,6 +253,10 @@ int main(int argc, char** argv) {
     }
     if (o.trajectory.empty()) throw Error("--trajectory is required (or --benchmark / --demo)");
 
+    if (args.isSet("measure-speed")) {
+      measureSpeed(o, std::max(1, args.getInt("measure-speed")));
+      return 0;
+    }
     if (args.isSet("preview")) {
       SequenceOptions p = o;
       const std::string tmp =

@@ -39,16 +39,4 @@ CameraRayTable::CameraRayTable(const CameraModel& camera, int threads)
     }
 }
 
-Eigen::Vector3f CameraRayTable::ray(float x, float y) const {
-  const float gx = std::clamp(2.0f * (x + 0.5f), 0.0f, static_cast<float>(grid_w_ - 1) - 1e-3f);
-  const float gy = std::clamp(2.0f * (y + 0.5f), 0.0f, static_cast<float>(grid_h_ - 1) - 1e-3f);
-  const int i = static_cast<int>(gx), j = static_cast<int>(gy);
-  const float fx = gx - i, fy = gy - j;
-  const std::size_t k = static_cast<std::size_t>(j) * grid_w_ + i;
-  const Eigen::Vector3f top = grid_[k] + fx * (grid_[k + 1] - grid_[k]);
-  const Eigen::Vector3f bottom =
-      grid_[k + grid_w_] + fx * (grid_[k + grid_w_ + 1] - grid_[k + grid_w_]);
-  return (top + fy * (bottom - top)).normalized();
-}
-
 }  // namespace alvio::sim

@@ -390,10 +390,12 @@ Texture::Texture(const cv::Mat1f& albedo, double texel_m, bool repeat)
   if (repeat && (!power_of_two(albedo.cols) || !power_of_two(albedo.rows)))
     throw Error("a repeating texture needs power-of-two sizes, got " + std::to_string(albedo.cols) +
                 "x" + std::to_string(albedo.rows));
-  levels_.push_back(albedo.clone());
+  cv::Mat1b level0;
+  albedo.convertTo(level0, CV_8U, 255.0);  // rounds and saturates
+  levels_.push_back(level0);
   while (levels_.back().cols > 1 && levels_.back().rows > 1 && levels_.size() < 14) {
-    const cv::Mat1f& prev = levels_.back();
-    cv::Mat1f next;
+    const cv::Mat1b& prev = levels_.back();
+    cv::Mat1b next;
     cv::resize(prev, next, cv::Size((prev.cols + 1) / 2, (prev.rows + 1) / 2), 0, 0,
                cv::INTER_AREA);
     levels_.push_back(next);

@@ -44,6 +44,7 @@ RadianceRenderer::RadianceRenderer(const Scene& scene, const SceneAppearance& ap
       const Eigen::Vector3f c[4] = {rays.ray(x0, y0), rays.ray(x1, y0), rays.ray(x1, y1),
                                     rays.ray(x0, y1)};
       const Eigen::Vector3f centre = (c[0] + c[1] + c[2] + c[3]).normalized();
+      for (int k = 0; k < 4; ++k) t.corner_c[k] = c[k];
       for (int k = 0; k < 4; ++k) {
         Eigen::Vector3f n = c[k].cross(c[(k + 1) % 4]).normalized();
         if (n.dot(centre) < 0) n = -n;
@@ -64,8 +65,11 @@ RadianceRenderer::RadianceRenderer(const Scene& scene, const SceneAppearance& ap
 
 void RadianceRenderer::cullTile(const Tile& tile, const Eigen::Matrix3f& R,
                                 const Eigen::Vector3f& o, std::vector<Candidate>* out) const {
-  Eigen::Vector3f n[4];
-  for (int k = 0; k < 4; ++k) n[k] = R * tile.normal_c[k];
+  Eigen::Vector3f n[4], corner_ray[4];
+  for (int k = 0; k < 4; ++k) {
+    n[k] = R * tile.normal_c[k];
+    corner_ray[k] = R * tile.corner_c[k];
+  }
   const float slack = tile.slack;
   // A box is outside if, for some plane, even its most inward corner is outside by
   // more than the slack allows at its distance.
@@ -97,14 +101,20 @@ void RadianceRenderer::cullTile(const Tile& tile, const Eigen::Matrix3f& R,
         }
       if (all_out) return;
     }
-    // Nearest possible distance: to the quad's plane, and to its bounding box.
+    // Nearest possible distance: to its bounding box, and along the tile's rays to its
+    // plane. A ray d meets the plane at |side| / |n.d|, and |n.d| over the tile's rays
+    // is at most its largest value at the pyramid's corners (plus the slack): planes
+    // seen at a grazing angle are far along every ray of the tile.
     Eigen::Vector3f lo = corner[0], hi = corner[0];
     for (int i = 1; i < 4; ++i) {
       lo = lo.cwiseMin(corner[i]);
       hi = hi.cwiseMax(corner[i]);
     }
     const float box = (o.cwiseMax(lo).cwiseMin(hi) - o).norm();
-    out->push_back({std::max(std::abs(side), box) * 0.999f - 1e-4f, qi});
+    float max_cos = 0;
+    for (const auto& r : corner_ray) max_cos = std::max(max_cos, std::abs(q.normal.dot(r)));
+    const float along = std::abs(side) / std::min(1.0f, max_cos * 1.002f + 2 * slack + 1e-3f);
+    out->push_back({std::max(along, box) * 0.999f - 1e-4f, qi});
   });
   std::sort(out->begin(), out->end(), [](const Candidate& a, const Candidate& b) {
     return a.min_distance < b.min_distance || (a.min_distance == b.min_distance && a.quad < b.quad);
@@ -128,23 +138,21 @@ float RadianceRenderer::shade(int quad, const Eigen::Vector3f& dir, float t, flo
   return albedo * appearance_.lightMap(quad).irradiance(back, a, b);
 }
 
-RadianceRenderer::Hit RadianceRenderer::trace(const std::vector<Candidate>& candidates,
-                                              const Eigen::Vector3f& origin,
-                                              const Eigen::Vector3f& dir, float pixel_angle) const {
+RadianceRenderer::Hit RadianceRenderer::intersect(const std::vector<Candidate>& candidates,
+                                                  const Eigen::Vector3f& origin,
+                                                  const Eigen::Vector3f& dir) const {
   const auto& quads = scene_.fastQuads();
-  float t = 1e30f, a = 0, b = 0;
-  int best = -1;
+  Hit hit{-1, 1e30f, 0, 0};
   for (const Candidate& c : candidates) {
-    if (c.min_distance >= t) break;  // nothing further down the list can be nearer
+    if (c.min_distance >= hit.t) break;  // nothing further down the list can be nearer
     float qa, qb;
-    if (Scene::intersectFast(quads[c.quad], origin, dir, &t, &qa, &qb)) {
-      best = c.quad;
-      a = qa;
-      b = qb;
+    if (Scene::intersectFast(quads[c.quad], origin, dir, &hit.t, &qa, &qb)) {
+      hit.quad = c.quad;
+      hit.a = qa;
+      hit.b = qb;
     }
   }
-  if (best < 0) return {-1, 0.0f};
-  return {best, shade(best, dir, t, a, b, pixel_angle)};
+  return hit;
 }
 
 cv::Mat1f RadianceRenderer::render(const Eigen::Isometry3d& T_w_c, const RenderOptions& options,
@@ -167,40 +175,74 @@ cv::Mat1f RadianceRenderer::render(const Eigen::Isometry3d& T_w_c, const RenderO
         float* out = image.ptr<float>(v);
         int* id = ids.ptr<int>(v);
         for (int u = tile.u0; u < tile.u1; ++u) {
-          const Hit s =
-              trace(candidates[ti], origin, R * rays_.centerRay(u, v), rays_.pixelAngle(u, v));
-          out[u] = s.value;
-          id[u] = s.quad;
+          const Eigen::Vector3f dir = R * rays_.centerRay(u, v);
+          const Hit hit = intersect(candidates[ti], origin, dir);
+          out[u] = hit.quad < 0 ? 0.0f
+                                : shade(hit.quad, dir, hit.t, hit.a, hit.b, rays_.pixelAngle(u, v));
+          id[u] = hit.quad;
         }
       }
     }
   });
 
-  // Pass 2: pixels on a geometric edge get n x n sub-pixel rays.
+  // Pass 2: pixels on a visible geometric edge get n x n sub-pixel rays, which find
+  // how much of the pixel each quad covers. Each quad is shaded once (textures are
+  // already filtered over the pixel's footprint); the pixel is the coverage-weighted
+  // mean.
   const int n = std::max(1, options.edge_samples);
   if (n > 1) {
     cv::Mat1f refined = image.clone();
+    const float contrast = options.edge_contrast;
     parallelFor(tiles_y_, threads, [&](int ty) {
       for (int tx = 0; tx < tiles_x_; ++tx) {
         const int ti = ty * tiles_x_ + tx;
         const Tile& tile = tiles_[ti];
         for (int v = tile.v0; v < tile.v1; ++v) {
           const int* row = ids.ptr<int>(v);
-          const int* up = ids.ptr<int>(std::max(v - 1, 0));
-          const int* down = ids.ptr<int>(std::min(v + 1, h - 1));
+          const float* val = image.ptr<float>(v);
+          const int vu = std::max(v - 1, 0), vd = std::min(v + 1, h - 1);
           float* out = refined.ptr<float>(v);
           for (int u = tile.u0; u < tile.u1; ++u) {
             const int c = row[u];
-            if (row[std::max(u - 1, 0)] == c && row[std::min(u + 1, w - 1)] == c && up[u] == c &&
-                down[u] == c)
+            const float x0 = val[u];
+            auto differs = [&](int uu, int vv) {
+              if (ids(vv, uu) == c) return false;
+              const float x1 = image(vv, uu);
+              return std::abs(x1 - x0) > contrast * std::max(x0, x1) + 1e-4f;
+            };
+            if (!differs(std::max(u - 1, 0), v) && !differs(std::min(u + 1, w - 1), v) &&
+                !differs(u, vu) && !differs(u, vd))
               continue;
-            const float angle = rays_.pixelAngle(u, v) / n;
-            float sum = 0;
+            const float angle = rays_.pixelAngle(u, v);
+            constexpr int kMaxQuads = 6;
+            int quad[kMaxQuads], count[kMaxQuads];
+            float value[kMaxQuads];
+            int distinct = 1;
+            quad[0] = c;
+            count[0] = 0;
+            value[0] = x0;
             for (int j = 0; j < n; ++j)
               for (int i = 0; i < n; ++i) {
                 const float x = u - 0.5f + (i + 0.5f) / n, y = v - 0.5f + (j + 0.5f) / n;
-                sum += trace(candidates[ti], origin, R * rays_.ray(x, y), angle).value;
+                const Eigen::Vector3f dir = R * rays_.ray(x, y);
+                const Hit hit = intersect(candidates[ti], origin, dir);
+                int k = 0;
+                while (k < distinct && quad[k] != hit.quad) ++k;
+                if (k == distinct) {
+                  if (distinct == kMaxQuads)
+                    k = 0;  // (never in practice) fold into the centre
+                  else {
+                    quad[k] = hit.quad;
+                    count[k] = 0;
+                    value[k] =
+                        hit.quad < 0 ? 0.0f : shade(hit.quad, dir, hit.t, hit.a, hit.b, angle);
+                    ++distinct;
+                  }
+                }
+                ++count[k];
               }
+            float sum = 0;
+            for (int k = 0; k < distinct; ++k) sum += count[k] * value[k];
             out[u] = sum / (n * n);
           }
         }

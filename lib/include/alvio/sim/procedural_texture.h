@@ -35,6 +35,8 @@ const std::vector<std::string>& texturePatterns();
 
 /// A texture with its mip-map pyramid; sampled bilinearly within a level and
 /// linearly between levels (trilinear), repeating or clamped at the border.
+/// Stored with 8 bits per texel: four times less memory traffic than floats, and
+/// the albedo steps (1/255) stay below the sensor noise.
 class Texture {
  public:
   Texture() = default;
@@ -44,7 +46,7 @@ class Texture {
   int width() const { return levels_.empty() ? 0 : levels_[0].cols; }
   int height() const { return levels_.empty() ? 0 : levels_[0].rows; }
   double texelSize() const { return texel_m_; }
-  const cv::Mat1f& level(int i) const { return levels_[i]; }
+  const cv::Mat1b& level(int i) const { return levels_[i]; }
   int levels() const { return static_cast<int>(levels_.size()); }
 
   /// Albedo at (x, y) in level-0 texels (x right, y down; texel centres at +0.5),
@@ -70,7 +72,7 @@ class Texture {
            1.65677798f;
   }
   float bilinear(std::size_t level, float x, float y) const {
-    const cv::Mat1f& m = levels_[level];
+    const cv::Mat1b& m = levels_[level];
     const float s = 1.0f / static_cast<float>(1 << level);
     const float fx = x * s - 0.5f, fy = y * s - 0.5f;
     const float x0f = std::floor(fx), y0f = std::floor(fy);
@@ -90,15 +92,16 @@ class Texture {
       y0 = clampInt(y0, m.rows);
       y1 = clampInt(y1, m.rows);
     }
-    const float* r0 = m.ptr<float>(y0);
-    const float* r1 = m.ptr<float>(y1);
-    const float top = r0[x0] + ax * (r0[x1] - r0[x0]);
-    const float bottom = r1[x0] + ax * (r1[x1] - r1[x0]);
-    return top + ay * (bottom - top);
+    const uint8_t* r0 = m.ptr<uint8_t>(y0);
+    const uint8_t* r1 = m.ptr<uint8_t>(y1);
+    const float a00 = r0[x0], a01 = r0[x1], a10 = r1[x0], a11 = r1[x1];
+    const float top = a00 + ax * (a01 - a00);
+    const float bottom = a10 + ax * (a11 - a10);
+    return (top + ay * (bottom - top)) * (1.0f / 255.0f);
   }
   static int clampInt(int i, int n) { return i < 0 ? 0 : (i >= n ? n - 1 : i); }
 
-  std::vector<cv::Mat1f> levels_;
+  std::vector<cv::Mat1b> levels_;
   double texel_m_ = 0.01;
   bool repeat_ = true;
 };

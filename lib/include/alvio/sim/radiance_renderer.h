@@ -26,6 +26,9 @@ struct RenderOptions {
   int threads = 1;
   /// Sub-samples per side in edge pixels (1 = no anti-aliasing).
   int edge_samples = 3;
+  /// A pixel is an edge pixel when a neighbour hits another quad and their values
+  /// differ by more than this fraction (edges nobody can see need no sub-samples).
+  float edge_contrast = 0.02f;
 };
 
 class RadianceRenderer {
@@ -44,6 +47,7 @@ class RadianceRenderer {
   struct Tile {
     int u0, v0, u1, v1;
     Eigen::Vector3f normal_c[4];  ///< inward normals of the tile's pyramid, camera frame
+    Eigen::Vector3f corner_c[4];  ///< the pyramid's corner rays (unit), camera frame
     float slack;                  ///< angular slack (rad) so that every ray is inside
   };
   struct Candidate {
@@ -51,13 +55,13 @@ class RadianceRenderer {
     int quad;
   };
   struct Hit {
-    int quad;
-    float value;
+    int quad;  ///< -1: nothing hit
+    float t, a, b;
   };
   void cullTile(const Tile& tile, const Eigen::Matrix3f& R, const Eigen::Vector3f& origin,
                 std::vector<Candidate>* out) const;
-  Hit trace(const std::vector<Candidate>& candidates, const Eigen::Vector3f& origin,
-            const Eigen::Vector3f& dir, float pixel_angle) const;
+  Hit intersect(const std::vector<Candidate>& candidates, const Eigen::Vector3f& origin,
+                const Eigen::Vector3f& dir) const;
   float shade(int quad, const Eigen::Vector3f& dir, float t, float a, float b,
               float pixel_angle) const;
 
