@@ -231,8 +231,8 @@ SequenceSummary generateSequence(const SequenceOptions& o, const std::string& ou
   const double t_from = samples.front().t + o.start_s;
   const double t_to =
       o.duration_s > 0 ? std::min(samples.back().t, t_from + o.duration_s) : samples.back().t;
-  if (!(t_to > t_from + 0.5))
-    throw Error("--start/--duration leave less than 0.5 s of the trajectory");
+  if (!(t_to > t_from + 0.1))
+    throw Error("--start/--duration leave less than 0.1 s of the trajectory");
   Trajectory window;
   for (const StampedPose& p : samples)
     if (p.t >= t_from - 1.0 && p.t <= t_to + 1.0) window.push_back(p);

@@ -38,7 +38,8 @@ class PoseSpline {
   double endTime() const { return t0_ + dt_ * static_cast<double>(segments()); }
   double knotSpacing() const { return dt_; }
   int segments() const { return static_cast<int>(positions_.size()) - 3; }
-  bool contains(double t) const { return t >= t0_ - 1e-9 && t <= endTime() + 1e-9; }
+  /// With 1 us of slack: absolute (epoch) times in double carry about 0.2 us of rounding.
+  bool contains(double t) const { return t >= t0_ - 1e-6 && t <= endTime() + 1e-6; }
 
   const Vector3dList& positionControls() const { return positions_; }
   const QuaternionList& rotationControls() const { return rotations_; }
