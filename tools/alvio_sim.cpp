@@ -125,7 +125,8 @@ void measureSpeed(const SequenceOptions& o, int frames) {
     co.render.threads = 1;
     co.illumination = o.illumination;
     CameraSimulator sim(scene.scene, appearance, *camera, o.config.camera.T_b_c, co);
-    sim.setExposureFromView(spline, spline.startTime() + 1);
+    sim.setExposureFromViews(
+        spline, {spline.startTime() + 1, 0.5 * (spline.startTime() + spline.endTime())});
     std::vector<double> times;
     const double span = spline.endTime() - spline.startTime() - 2;
     for (int i = 0; i < frames; ++i)

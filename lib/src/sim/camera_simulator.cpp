@@ -15,8 +15,11 @@ CameraSimulator::CameraSimulator(const Scene& scene, const SceneAppearance& appe
   sensor_ = std::make_unique<ImageSensor>(*rays_, options.sensor);
 }
 
-void CameraSimulator::setExposureFromView(const PoseSpline& trajectory, double t) {
-  sensor_->setExposureFrom(radiance(cameraPose(trajectory, t)));
+void CameraSimulator::setExposureFromViews(const PoseSpline& trajectory,
+                                           const std::vector<double>& times) {
+  std::vector<cv::Mat1f> views;
+  for (double t : times) views.push_back(radiance(cameraPose(trajectory, t)));
+  sensor_->setExposureFrom(views);
 }
 
 cv::Mat1f CameraSimulator::radiance(const Eigen::Isometry3d& T_w_c) const {

@@ -69,9 +69,10 @@ ImageSensor::ImageSensor(const CameraRayTable& rays, const SensorOptions& option
     }
 }
 
-void ImageSensor::setExposureFrom(const cv::Mat1f& radiance) {
-  if (options_.target_mean_dn <= 0) return;
-  const double mean = cv::mean(radiance.mul(vignette_))[0];
+void ImageSensor::setExposureFrom(const std::vector<cv::Mat1f>& radiance) {
+  if (options_.target_mean_dn <= 0 || radiance.empty()) return;
+  double mean = 0;
+  for (const cv::Mat1f& r : radiance) mean += cv::mean(r.mul(vignette_))[0] / radiance.size();
   if (mean > 1e-6) options_.exposure_dn = options_.target_mean_dn / mean;
 }
 

@@ -14,6 +14,8 @@ ImageStatistics measureImage(const cv::Mat1b& image) {
   std::vector<cv::Point2f> corners;
   cv::goodFeaturesToTrack(image, corners, 150, 0.01, 30);
   s.corners = static_cast<int>(corners.size());
+  cv::goodFeaturesToTrack(image, corners, 2000, 0.01, 30);
+  s.corners_uncapped = static_cast<int>(corners.size());
 
   const double min_length = 0.06 * std::hypot(image.cols, image.rows);
   cv::Ptr<cv::LineSegmentDetector> lsd = cv::createLineSegmentDetector(cv::LSD_REFINE_STD);
@@ -43,6 +45,7 @@ StatisticsSummary summarize(const std::vector<ImageStatistics>& stats) {
   r.min_segments = r.max_segments = stats[0].segments;
   for (const auto& s : stats) {
     r.mean_corners += s.corners;
+    r.mean_corners_uncapped += s.corners_uncapped;
     r.mean_segments += s.segments;
     r.mean_grey += s.mean;
     r.mean_stddev += s.stddev;
@@ -54,6 +57,7 @@ StatisticsSummary summarize(const std::vector<ImageStatistics>& stats) {
   }
   const double n = static_cast<double>(stats.size());
   r.mean_corners /= n;
+  r.mean_corners_uncapped /= n;
   r.mean_segments /= n;
   r.mean_grey /= n;
   r.mean_stddev /= n;
@@ -64,9 +68,10 @@ StatisticsSummary summarize(const std::vector<ImageStatistics>& stats) {
 std::string StatisticsSummary::format(const std::string& label) const {
   std::ostringstream os;
   os << std::fixed << std::setprecision(1) << label << ": " << images << " images, KLT corners "
-     << mean_corners << " (" << min_corners << ".." << max_corners << "), LSD segments "
-     << mean_segments << " (" << min_segments << ".." << max_segments << "), grey " << mean_grey
-     << " +- " << mean_stddev << ", gradient " << mean_gradient;
+     << mean_corners << " (" << min_corners << ".." << max_corners << "; uncapped "
+     << mean_corners_uncapped << "), LSD segments " << mean_segments << " (" << min_segments << ".."
+     << max_segments << "), grey " << mean_grey << " +- " << mean_stddev << ", gradient "
+     << mean_gradient;
   return os.str();
 }
 

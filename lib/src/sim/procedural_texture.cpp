@@ -127,7 +127,9 @@ cv::Mat1f concrete(const TextureSpec& s, int w, int h, double density, uint64_t 
   const int panels_x = cellsAcross(size_x, 2 * s.feature_m);
   const int panels_y = cellsAcross(size_y, s.feature_m);
   SeededRandom rng(mixSeed(seed, 5));
-  const int seam = std::max(1, static_cast<int>(std::lround(0.006 / s.texel_m)));
+  // Seams (formwork joints on walls, saw-cut joints on floors) widen with the panel size.
+  const double seam_m = std::clamp(0.005 * s.feature_m, 0.006, 0.02);
+  const int seam = std::max(1, static_cast<int>(std::lround(seam_m / s.texel_m)));
   for (int i = 0; i <= panels_x; ++i) {
     const int x = i * w / panels_x;
     cv::line(marks, {x, 0}, {x, h}, 128 - 70, seam, cv::LINE_AA);
@@ -146,9 +148,32 @@ cv::Mat1f concrete(const TextureSpec& s, int w, int h, double density, uint64_t 
           cv::circle(marks, {x, y}, std::max(1, static_cast<int>(hole_r)), 128 - 110, cv::FILLED,
                      cv::LINE_AA);
         }
-  const int pits = static_cast<int>(size_x * size_y * 25);
+  const int pits = static_cast<int>(size_x * size_y * 10);
   addDots(marks, rng, pits, 0.004 / s.texel_m, 0.012 / s.texel_m, 128 - 90);
   addDots(marks, rng, pits / 3, 0.01 / s.texel_m, 0.03 / s.texel_m, 128 + 50);
+  // Stains (oil, water, patches): fewer and larger, soft.
+  cv::Mat1b stains(h, w, uint8_t(128));
+  for (int i = 0, n = static_cast<int>(size_x * size_y * 0.12); i < n; ++i) {
+    // Elongated, of random darkness: oil drips, tyre marks, patches.
+    const cv::Point c(rng.uniformInt(0, w - 1), rng.uniformInt(0, h - 1));
+    const cv::Size axes(static_cast<int>(rng.uniform(0.05, 0.4) / s.texel_m),
+                        static_cast<int>(rng.uniform(0.03, 0.15) / s.texel_m));
+    const double angle = rng.uniform(0, 180);
+    const uint8_t value = static_cast<uint8_t>(128 - rng.uniformInt(15, 70));
+    for (int ox = -1; ox <= 1; ++ox)
+      for (int oy = -1; oy <= 1; ++oy)
+        cv::ellipse(stains, c + cv::Point(ox * w, oy * h), axes, angle, 0, 360, value, cv::FILLED,
+                    cv::LINE_AA);
+  }
+  {
+    // Blur with wrap-around so the texture still tiles without a seam.
+    const int pad = static_cast<int>(std::ceil(0.08 / s.texel_m));
+    cv::Mat1b padded;
+    cv::copyMakeBorder(stains, padded, pad, pad, pad, pad, cv::BORDER_WRAP);
+    cv::GaussianBlur(padded, padded, cv::Size(0, 0), 0.02 / s.texel_m);
+    padded(cv::Rect(pad, pad, w, h)).copyTo(stains);
+  }
+  addDrawing(img, stains, c * std::max(d, 0.15f));
   addDrawing(img, marks, c * d);
   return img;
 }

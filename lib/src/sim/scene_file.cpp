@@ -236,8 +236,13 @@ class SceneBuilder {
       shelf(o, shift, obj, index);
     } else if (type == "tray") {
       tray(o, shift, obj);
+    } else if (type == "railing") {
+      railing(o, shift, obj);
+    } else if (type == "stairs") {
+      stairs(o, shift, obj);
     } else {
-      o.fail("type", "is unknown: '" + type + "' (box, quad, room, pipe, frame, shelf, tray)");
+      o.fail("type", "is unknown: '" + type +
+                         "' (box, quad, room, pipe, frame, shelf, tray, railing, stairs)");
     }
   }
 
@@ -275,11 +280,24 @@ class SceneBuilder {
     // Top and bottom bars between the posts.
     box(c + (h - bar) / 2 * u, F, {w - 2 * bar, bar, depth}, mat, obj, o);
     if (!door) box(c - (h - bar) / 2 * u, F, {w - 2 * bar, bar, depth}, mat, obj, o);
+    const double inner_w = w - 2 * bar, inner_h = door ? h - bar : h - 2 * bar;
+    const Eigen::Vector3d inner_c = c - (door ? bar / 2 : 0.0) * u;
+    if (o.has("panes")) {
+      // Mullions (window bars) dividing the opening into cols x rows panes.
+      const auto panes = o.numbers("panes", 2);
+      const int cols = static_cast<int>(panes[0]), rows = static_cast<int>(panes[1]);
+      if (cols < 1 || rows < 1) o.fail("panes", "must be two counts >= 1");
+      const double m = 0.5 * bar;
+      for (int i = 1; i < cols; ++i)
+        box(inner_c + (-inner_w / 2 + i * inner_w / cols) * r, F, {m, inner_h, 0.6 * depth}, mat,
+            obj, o);
+      for (int j = 1; j < rows; ++j)
+        box(inner_c + (-inner_h / 2 + j * inner_h / rows) * u, F, {inner_w, m, 0.6 * depth}, mat,
+            obj, o);
+    }
     if (o.has("fill")) {
       // The panel sits recessed by half the frame depth.
-      const double inner_h = door ? h - bar : h - 2 * bar;
-      const Eigen::Vector3d pc = c - (door ? bar / 2 : 0.0) * u - 0.25 * depth * n;
-      quad(pc, F, {w - 2 * bar, inner_h}, materialOf(o, "fill"), obj, false);
+      quad(inner_c - 0.25 * depth * n, F, {inner_w, inner_h}, materialOf(o, "fill"), obj, false);
     }
   }
 
@@ -337,6 +355,50 @@ class SceneBuilder {
     for (int side : {-1, 1}) {
       const Eigen::Vector3d off = side * (w / 2 - t / 2) * y + Eigen::Vector3d(0, 0, h / 2);
       beam(a + off, b + off, t, h, mat, obj, o);
+    }
+  }
+
+  // Guard rail along a horizontal run: posts, a top and a middle rail, a toe board.
+  void railing(const Node& o, const Eigen::Vector3d& shift, int obj) {
+    const Eigen::Vector3d a = o.vec3("from") + shift, b = o.vec3("to") + shift;
+    const double h = o.number("height", 1.1), d = o.number("diameter", 0.045);
+    const double spacing = o.number("post_spacing", 1.5);
+    const int mat = materialOf(o, "material");
+    const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
+    const int posts = std::max(1, static_cast<int>(std::ceil((b - a).norm() / spacing)));
+    for (int i = 0; i <= posts; ++i) {
+      const Eigen::Vector3d p = a + (b - a) * (static_cast<double>(i) / posts);
+      beam(p, p + up * h, d, d, mat, obj, o);
+    }
+    beam(a + up * (h + d / 2), b + up * (h + d / 2), d, d, mat, obj, o);
+    beam(a + up * (h / 2), b + up * (h / 2), 0.8 * d, 0.8 * d, mat, obj, o);
+    beam(a + up * 0.05, b + up * 0.05, 0.02, 0.1, mat, obj, o);
+  }
+
+  // A straight flight of steps from `from` (bottom, front edge centre, on the floor)
+  // up to `to` (top landing height), with side stringers.
+  void stairs(const Node& o, const Eigen::Vector3d& shift, int obj) {
+    const Eigen::Vector3d a = o.vec3("from") + shift, b = o.vec3("to") + shift;
+    const double width = o.number("width", 1.0);
+    const int mat = materialOf(o, "material");
+    Eigen::Vector3d run = b - a;
+    const double rise = run.z();
+    run.z() = 0;
+    if (rise <= 0 || run.norm() < 0.1) o.fail("to", "must be higher than and away from 'from'");
+    const int steps = std::max(1, static_cast<int>(std::lround(rise / 0.19)));
+    const Eigen::Vector3d x = run.normalized();
+    Eigen::Matrix3d R;
+    R << x, Eigen::Vector3d::UnitZ().cross(x), Eigen::Vector3d::UnitZ();
+    const double step_run = run.norm() / steps, step_rise = rise / steps;
+    for (int i = 0; i < steps; ++i) {
+      const Eigen::Vector3d c =
+          a + x * ((i + 0.5) * step_run) + Eigen::Vector3d(0, 0, (i + 1) * step_rise - 0.02);
+      box(c, R, {step_run + 0.03, width, 0.04}, mat, obj, o);
+    }
+    for (int side : {-1, 1}) {
+      const Eigen::Vector3d off = R.col(1) * (side * (width / 2 + 0.03));
+      beam(a + off + Eigen::Vector3d(0, 0, 0.1), b + off + Eigen::Vector3d(0, 0, 0.05), 0.04, 0.25,
+           mat, obj, o);
     }
   }
 

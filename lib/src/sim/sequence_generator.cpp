@@ -338,7 +338,12 @@ SequenceSummary generateSequence(const SequenceOptions& o, const std::string& ou
   const auto camera = CameraModel::create(o.config.camera);
   CameraSimulator simulator(scene_file.scene, appearance, *camera, o.config.camera.T_b_c, co);
   const double t0 = nsToSec(frames.front());
-  simulator.setExposureFromView(spline, t0);
+  {
+    // Exposure from 8 views spread over the sequence (fixed afterwards).
+    std::vector<double> times;
+    for (int k = 0; k < 8; ++k) times.push_back(nsToSec(frames[(frames.size() - 1) * k / 7]));
+    simulator.setExposureFromViews(spline, times);
+  }
   summary.exposure_dn = simulator.exposure();
 
   const auto t_render = std::chrono::steady_clock::now();

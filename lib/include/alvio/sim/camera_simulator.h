@@ -34,9 +34,9 @@ class CameraSimulator {
   /// The 8-bit image at time t (seconds). `t_rel` is t relative to the sequence start,
   /// for the illumination profile. Deterministic in (seed, t).
   cv::Mat1b render(const PoseSpline& trajectory, double t, double t_rel) const;
-  /// Auto exposure: fix the sensor's exposure from the view at time t (no-op when the
-  /// sensor's target_mean_dn is 0). Call once, before rendering a sequence.
-  void setExposureFromView(const PoseSpline& trajectory, double t);
+  /// Auto exposure: fix the sensor's exposure from the views at these times (no-op
+  /// when the sensor's target_mean_dn is 0). Call once, before rendering a sequence.
+  void setExposureFromViews(const PoseSpline& trajectory, const std::vector<double>& times);
   double exposure() const { return sensor_->options().exposure_dn; }
   /// The noise-free radiance at one camera pose (no blur, no sensor).
   cv::Mat1f radiance(const Eigen::Isometry3d& T_w_c) const;

@@ -17,7 +17,7 @@ struct SensorOptions {
   double exposure_dn = 300.0;  ///< grey level (DN) of unit radiance at gain 1
   /// > 0: auto exposure, set once (then fixed, like a camera with exposure locked after
   /// start-up) so that the first frame's mean grey level is this many DN.
-  double target_mean_dn = 110.0;
+  double target_mean_dn = 115.0;
   double optical_blur_sigma_px = 0.6;  ///< Gaussian point-spread function (0 = sharp)
   double vignetting = 0.35;            ///< 0 none .. 1 the full cos^4 fall-off
   double read_noise_dn = 1.2;
@@ -30,8 +30,9 @@ class ImageSensor {
   ImageSensor(const CameraRayTable& rays, const SensorOptions& options);
 
   const SensorOptions& options() const { return options_; }
-  /// Fix exposure_dn so that `radiance` (before vignetting) has the target mean.
-  void setExposureFrom(const cv::Mat1f& radiance);
+  /// Fix exposure_dn so that these radiance images (after vignetting) have the
+  /// target mean grey level on average.
+  void setExposureFrom(const std::vector<cv::Mat1f>& radiance);
   /// `radiance` (linear) times `light_factor` (illumination over time) to 8 bits.
   cv::Mat1b expose(const cv::Mat1f& radiance, double light_factor, uint64_t seed) const;
 
