@@ -6,6 +6,7 @@
 #include "alvio/common/error.h"
 #include "alvio/config/config.h"
 #include "alvio/io/trajectory_io.h"
+#include "alvio/sim/edge_projection.h"
 #include "alvio/sim/procedural_trajectories.h"
 #include "alvio/sim/scene_file.h"
 #include "test_support.h"
@@ -190,4 +191,53 @@ TEST(SimSceneFile, MachineHallLeavesRoomForEveryEurocMhFlight) {
     EXPECT_LT(box.sizes().maxCoeff(), 40.0);
     std::cout << seq << ": smallest clearance " << worst << " m " << where << "\n";
   }
+}
+
+TEST(SimEdgeProjection, VisibleEdgesAndOcclusion) {
+  // A camera at the origin looking along +z (camera frame = world frame), a 1 m box
+  // 5 m ahead, and a 1 m box 10 m ahead that the near one partly hides.
+  Scene scene;
+  SceneMaterial m;
+  m.name = "grey";
+  scene.addMaterial(m);
+  scene.addBox({0, 0, 5}, Eigen::Matrix3d::Identity(), {1, 1, 1}, 0, scene.addObject("near"));
+  scene.addBox({0.9, 0, 10}, Eigen::Matrix3d::Identity(), {1, 1, 1}, 0, scene.addObject("far"));
+  scene.finalize();
+  const Config config = Config::load(Config::defaultPath());
+  const auto camera = CameraModel::create(config.camera);
+  const auto visible =
+      projectVisibleEdges(scene, *camera, Eigen::Isometry3d::Identity(), EdgeProjectionOptions{});
+  int near_edges = 0;
+  bool far_right = false, far_top = false;
+  for (const VisibleEdge& v : visible) {
+    const SceneEdge& e = scene.edges()[v.edge_id];
+    const std::string& object = scene.objectNames()[e.object];
+    // The end points project as the camera model says.
+    Eigen::Vector2d pa;
+    ASSERT_TRUE(camera->project(v.a_w, &pa));
+    EXPECT_LT((pa - v.a_px).norm(), 1e-9);
+    const bool front = std::abs(e.a.z() - e.b.z()) < 1e-9;  // in a face facing the camera
+    if (object == "near") {
+      // Only the front face (z = 4.5) shows; its edges are seen whole.
+      ++near_edges;
+      EXPECT_NEAR(e.a.z(), 4.5, 1e-9);
+      EXPECT_GT(v.visible_fraction, 0.95);
+      continue;
+    }
+    // The far box (x 0.4..1.4, front face z = 9.5) is partly behind the near one.
+    ASSERT_TRUE(front) << "a receding edge of the far box cannot be seen";
+    const bool vertical = std::abs(e.a.x() - e.b.x()) < 1e-9;
+    if (vertical) {
+      EXPECT_NEAR(e.a.x(), 1.4, 1e-9) << "the far box's left edge is hidden by the near box";
+      EXPECT_GT(v.visible_fraction, 0.95);
+      far_right = true;
+    } else if (e.a.y() > 0) {
+      // Hidden where x / 9.5 < 0.5 / 4.5, i.e. x < 1.056: about 1/3 of it shows.
+      EXPECT_NEAR(v.visible_fraction, (1.4 - 0.5 / 4.5 * 9.5) / 1.0, 0.05);
+      far_top = true;
+    }
+  }
+  EXPECT_EQ(near_edges, 4);
+  EXPECT_TRUE(far_right);
+  EXPECT_TRUE(far_top);
 }

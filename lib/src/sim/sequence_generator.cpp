@@ -18,6 +18,7 @@
 #include "alvio/common/progress_bar.h"
 #include "alvio/io/euroc_dataset.h"
 #include "alvio/io/trajectory_io.h"
+#include "alvio/sim/edge_projection.h"
 #include "alvio/sim/euroc_sequences.h"
 #include "alvio/sim/imu_simulator.h"
 #include "alvio/sim/procedural_trajectories.h"
@@ -138,6 +139,7 @@ void prepareOutputFolder(const fs::path& out) {
                 "' holds a mav0 folder that the simulator did not write; refusing to overwrite it");
   fs::remove_all(out / "mav0");
   fs::remove(out / "groundtruth.tum");
+  fs::remove(out / "scene_edges.csv");
   fs::remove(out / "sim_info.yaml");
   fs::create_directories(out / "mav0" / "cam0" / "data");
   fs::create_directories(out / "mav0" / "imu0");
@@ -401,6 +403,7 @@ SequenceSummary generateSequence(const SequenceOptions& o, const std::string& ou
     tum.push_back(p);
   }
   writeTumTrajectory((out / "groundtruth.tum").string(), tum);
+  writeSceneEdgesCsv((out / "scene_edges.csv").string(), scene_file.scene);
 
   summary.frames = n;
   summary.imu_samples = static_cast<int>(imu.size());

@@ -1,7 +1,8 @@
 #pragma once
 // A whole simulated sequence, written as an EuRoC ASL folder:
 //   mav0/cam0/{data.csv, data/<ns>.png, sensor.yaml}, mav0/imu0/{data.csv, sensor.yaml},
-//   mav0/state_groundtruth_estimate0/data.csv, plus groundtruth.tum and sim_info.yaml.
+//   mav0/state_groundtruth_estimate0/data.csv, plus groundtruth.tum, sim_info.yaml and
+//   scene_edges.csv (the scene's true 3D edges, for line-tracker evaluation).
 //
 // Two IMU modes. Synthetic: the body trajectory is a spline fitted to the
 // ground truth (or a built-in path); images, IMU and the written ground truth
@@ -21,7 +22,7 @@ namespace alvio::sim {
 
 /// Bumped whenever the simulator's output for the same inputs changes, so that
 /// cached benchmark sequences are rebuilt.
-constexpr const char* kSimulatorVersion = "alvio-sim 1";
+constexpr const char* kSimulatorVersion = "alvio-sim 2";
 
 struct SequenceOptions {
   std::string scene;       ///< scene file or name; "" = the built-in machine hall
