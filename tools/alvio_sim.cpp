@@ -263,7 +263,7 @@ int main(int argc, char** argv) {
       const std::string tmp =
           (fs::temp_directory_path() / ("alvio_sim_preview_" + std::to_string(::getpid())))
               .string();
-      p.duration_s = 0.06;
+      p.duration_s = 0.15;
       p.still_s = 0;
       p.progress = false;
       generateSequence(p, tmp);
