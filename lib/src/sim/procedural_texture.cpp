@@ -148,8 +148,8 @@ cv::Mat1f concrete(const TextureSpec& s, int w, int h, double density, uint64_t 
           cv::circle(marks, {x, y}, std::max(1, static_cast<int>(hole_r)), 128 - 110, cv::FILLED,
                      cv::LINE_AA);
         }
-  const int pits = static_cast<int>(size_x * size_y * 10);
-  addDots(marks, rng, pits, 0.004 / s.texel_m, 0.012 / s.texel_m, 128 - 90);
+  const int pits = static_cast<int>(size_x * size_y * 6);
+  addDots(marks, rng, pits, 0.004 / s.texel_m, 0.012 / s.texel_m, 128 - 70);
   addDots(marks, rng, pits / 3, 0.01 / s.texel_m, 0.03 / s.texel_m, 128 + 50);
   // Stains (oil, water, patches): fewer and larger, soft.
   cv::Mat1b stains(h, w, uint8_t(128));

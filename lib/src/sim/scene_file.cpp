@@ -148,7 +148,7 @@ Eigen::Matrix3d planeFrame(Eigen::Vector3d normal, const Node& o) {
 
 class SceneBuilder {
  public:
-  SceneBuilder(Scene* scene) : scene_(scene) {}
+  explicit SceneBuilder(Scene* scene) : scene_(scene) {}
 
   void material(const std::string& name, const Node& m) {
     SceneMaterial mat;

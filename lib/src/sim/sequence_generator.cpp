@@ -170,12 +170,14 @@ std::string describeSequenceInputs(const SequenceOptions& o) {
   const auto& c = o.config.camera;
   const auto& imu = o.config.imu;
   const auto& s = o.camera.sensor;
+  // Files by content hash, not by path: moving the checkout or the shared data does
+  // not invalidate cached sequences.
   os << "simulator: " << kSimulatorVersion << "\n"
-     << "scene: " << in.scene_path << " " << fileHash(in.scene_path) << "\n"
-     << "trajectory: " << o.trajectory << " " << in.procedural << " " << in.trajectory_path << " "
-     << fileHash(in.trajectory_path) << "\n"
+     << "scene: " << fs::path(in.scene_path).filename().string() << " " << fileHash(in.scene_path)
+     << "\n"
+     << "trajectory: " << o.trajectory << " " << fileHash(in.trajectory_path) << "\n"
      << "imu: " << o.imu << " " << fileHash(in.imu_path) << "\n"
-     << "cam_timestamps: " << in.stamps_path << " " << fileHash(in.stamps_path) << "\n"
+     << "cam_timestamps: " << fileHash(in.stamps_path) << "\n"
      << "start: " << o.start_s << " duration: " << o.duration_s << " still: " << o.still_s
      << " seed: " << o.seed << " texture: " << o.texture << "\n"
      << "illumination: " << o.illumination.describe() << "\n"
@@ -388,8 +390,7 @@ SequenceSummary generateSequence(const SequenceOptions& o, const std::string& ou
 
   // --- write the ASL folder
   writeEurocImageCsv((out / "mav0" / "cam0" / "data.csv").string(), frames);
-  CameraOptions cam = o.config.camera;
-  writeEurocCameraYaml((out / "mav0" / "cam0" / "sensor.yaml").string(), cam);
+  writeEurocCameraYaml((out / "mav0" / "cam0" / "sensor.yaml").string(), o.config.camera);
   writeEurocImuCsv((out / "mav0" / "imu0" / "data.csv").string(), imu);
   writeEurocImuYaml((out / "mav0" / "imu0" / "sensor.yaml").string(), o.config.imu);
   writeEurocGroundTruthCsv((out / "mav0" / "state_groundtruth_estimate0" / "data.csv").string(),
