@@ -173,7 +173,7 @@ cv::Mat1f concrete(const TextureSpec& s, int w, int h, double density, uint64_t 
     cv::GaussianBlur(padded, padded, cv::Size(0, 0), 0.02 / s.texel_m);
     padded(cv::Rect(pad, pad, w, h)).copyTo(stains);
   }
-  addDrawing(img, stains, c * std::max(d, 0.15f));
+  addDrawing(img, stains, c * d);
   addDrawing(img, marks, c * d);
   return img;
 }
@@ -204,7 +204,8 @@ cv::Mat1f bricks(const TextureSpec& s, int w, int h, double density, uint64_t se
     const float joint = std::clamp((mortar * 0.5f - std::min(ex, ey)) + 0.5f, 0.0f, 1.0f);
     const float brick = static_cast<float>(s.albedo) + c * d * 0.5f * tone +
                         0.2f * c * d * noise.fbm(u, v, gx, gy, 2);
-    const float mortar_v = static_cast<float>(s.albedo) + c * (0.3f + 0.4f * d);
+    // Written so that density 1 gives the same value as ever; the joints fade with it.
+    const float mortar_v = static_cast<float>(s.albedo) + c * (0.3f * d + 0.4f * d);
     return (1 - joint) * brick + joint * mortar_v + 0.3f * c * noise.fbm(u, v, sx, sy, 3);
   });
   return img;
@@ -283,7 +284,7 @@ cv::Mat1f wood(const TextureSpec& s, int w, int h, double density, uint64_t seed
     const float tone = static_cast<float>((mixSeed(seed, p) % 1000) / 1000.0 - 0.5);
     const float grain = noise.fbm(u + 0.13f * p, v, grain_x, grain_y, 3);
     const float board = static_cast<float>(s.albedo) + c * d * (0.4f * tone + 0.5f * grain);
-    return (1 - joint) * board + joint * (static_cast<float>(s.albedo) - c * (0.3f + 0.7f * d));
+    return (1 - joint) * board + joint * (static_cast<float>(s.albedo) - c * (0.3f * d + 0.7f * d));
   });
   return img;
 }
@@ -302,7 +303,7 @@ cv::Mat1f stripes(const TextureSpec& s, int w, int h, double density, uint64_t s
     // Soft edges (about one texel) so that the stripes do not alias.
     const float edge = 0.5f * nx / w + 0.5f * ny / h;
     const float on = std::clamp((std::min(f, 1 - f) - 0.25f) / edge + 0.5f, 0.0f, 1.0f);
-    return static_cast<float>(s.albedo) + c * std::max(d, 0.15f) * (on - 0.5f) * 2.0f +
+    return static_cast<float>(s.albedo) + c * d * (on - 0.5f) * 2.0f +
            0.2f * c * noise.fbm(u, v, dx, dy, 4);
   });
   return img;

@@ -4,9 +4,10 @@
 // posters with shapes and text. All are deterministic for a seed. Shared
 // textures tile seamlessly, so large surfaces can repeat them with offsets.
 //
-// The density knob (0..1) scales everything that makes a surface "textured":
-// at 1 surfaces are rich in corners, near 0 they become plain and only the
-// geometry's edges and the shading remain.
+// The density knob (0..1) scales everything that makes a surface "textured"
+// (grain, pits, joints, seams, stripes, stains, poster contents): at 1 surfaces
+// are rich in corners, near 0 they become plain and only the geometry's edges,
+// the shading and some smooth large-scale variation remain.
 
 #include <opencv2/core.hpp>
 #include <string>
