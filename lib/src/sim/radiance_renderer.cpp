@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <thread>
 #include <vector>
 
@@ -114,11 +115,49 @@ void RadianceRenderer::cullTile(const Tile& tile, const Eigen::Matrix3f& R,
     float max_cos = 0;
     for (const auto& r : corner_ray) max_cos = std::max(max_cos, std::abs(q.normal.dot(r)));
     const float along = std::abs(side) / std::min(1.0f, max_cos * 1.002f + 2 * slack + 1e-3f);
-    out->push_back({std::max(along, box) * 0.999f - 1e-4f, qi});
+    const Eigen::Vector3f to_camera = o - q.origin;
+    out->push_back({std::max(along, box) * 0.999f - 1e-4f, qi, q.normal, q.u_scaled, q.v_scaled,
+                    -side, to_camera.dot(q.u_scaled), to_camera.dot(q.v_scaled)});
   });
   std::sort(out->begin(), out->end(), [](const Candidate& a, const Candidate& b) {
     return a.min_distance < b.min_distance || (a.min_distance == b.min_distance && a.quad < b.quad);
   });
+
+  // Occlusion: if a quad covers the whole tile (every ray of it, slack included, hits
+  // it) no farther than D, no candidate whose nearest possible distance exceeds D can
+  // be seen in this tile: drop them. They would only have been tested and missed, so
+  // the image does not change; walls and floors then hide what lies behind them.
+  float cover = std::numeric_limits<float>::max();
+  const int checks = std::min<int>(static_cast<int>(out->size()), 12);
+  for (int i = 0; i < checks; ++i) {
+    const Candidate& c = (*out)[i];
+    if (c.min_distance >= cover) break;
+    const Scene::FastQuad& q = quads[c.quad];
+    const float side = q.normal.dot(o - q.origin);
+    const Eigen::Vector3f n_in = side > 0 ? -q.normal : q.normal;  // along the view
+    float min_cos = 1.0f;
+    for (const auto& r : corner_ray) min_cos = std::min(min_cos, n_in.dot(r));
+    const float margin_cos = min_cos - 2 * slack - 1e-3f;
+    if (margin_cos < 0.05f) continue;  // grazing: not worth it
+    const float far = std::abs(side) / margin_cos;
+    const float margin = 2.0f * (slack + 1e-3f) * far / margin_cos + 1e-3f;
+    bool covers = true;
+    for (const auto& r : corner_ray) {
+      const float t = std::abs(side) / n_in.dot(r);
+      const Eigen::Vector3f d = o + t * r - q.origin;
+      const float a = d.dot(q.u_scaled) * q.length_u, b = d.dot(q.v_scaled) * q.length_v;
+      if (a < margin || a > q.length_u - margin || b < margin || b > q.length_v - margin) {
+        covers = false;
+        break;
+      }
+    }
+    if (covers) cover = std::min(cover, far);
+  }
+  if (cover < std::numeric_limits<float>::max()) {
+    out->erase(std::remove_if(out->begin(), out->end(),
+                              [&](const Candidate& c) { return c.min_distance > cover; }),
+               out->end());
+  }
 }
 
 float RadianceRenderer::shade(int quad, const Eigen::Vector3f& dir, float t, float a, float b,
@@ -139,18 +178,19 @@ float RadianceRenderer::shade(int quad, const Eigen::Vector3f& dir, float t, flo
 }
 
 RadianceRenderer::Hit RadianceRenderer::intersect(const std::vector<Candidate>& candidates,
-                                                  const Eigen::Vector3f& origin,
                                                   const Eigen::Vector3f& dir) const {
-  const auto& quads = scene_.fastQuads();
   Hit hit{-1, 1e30f, 0, 0};
   for (const Candidate& c : candidates) {
     if (c.min_distance >= hit.t) break;  // nothing further down the list can be nearer
-    float qa, qb;
-    if (Scene::intersectFast(quads[c.quad], origin, dir, &hit.t, &qa, &qb)) {
-      hit.quad = c.quad;
-      hit.a = qa;
-      hit.b = qb;
-    }
+    // Back faces need no test of their own: cullTile dropped one-sided quads whose back
+    // faces the camera, and rays leaving a plane get t < 0 (n.d = 0 gives inf or NaN).
+    const float t = c.num / c.n.dot(dir);
+    if (!(t > 1e-5f) || t >= hit.t) continue;
+    const float a = c.a0 + t * c.u_scaled.dot(dir);
+    if (a < 0.0f || a > 1.0f) continue;
+    const float b = c.b0 + t * c.v_scaled.dot(dir);
+    if (b < 0.0f || b > 1.0f) continue;
+    hit = {c.quad, t, a, b};
   }
   return hit;
 }
@@ -176,7 +216,7 @@ cv::Mat1f RadianceRenderer::render(const Eigen::Isometry3d& T_w_c, const RenderO
         int* id = ids.ptr<int>(v);
         for (int u = tile.u0; u < tile.u1; ++u) {
           const Eigen::Vector3f dir = R * rays_.centerRay(u, v);
-          const Hit hit = intersect(candidates[ti], origin, dir);
+          const Hit hit = intersect(candidates[ti], dir);
           out[u] = hit.quad < 0 ? 0.0f
                                 : shade(hit.quad, dir, hit.t, hit.a, hit.b, rays_.pixelAngle(u, v));
           id[u] = hit.quad;
@@ -225,19 +265,16 @@ cv::Mat1f RadianceRenderer::render(const Eigen::Isometry3d& T_w_c, const RenderO
               for (int i = 0; i < n; ++i) {
                 const float x = u - 0.5f + (i + 0.5f) / n, y = v - 0.5f + (j + 0.5f) / n;
                 const Eigen::Vector3f dir = R * rays_.ray(x, y);
-                const Hit hit = intersect(candidates[ti], origin, dir);
+                const Hit hit = intersect(candidates[ti], dir);
                 int k = 0;
                 while (k < distinct && quad[k] != hit.quad) ++k;
-                if (k == distinct) {
-                  if (distinct == kMaxQuads)
-                    k = 0;  // (never in practice) fold into the centre
-                  else {
-                    quad[k] = hit.quad;
-                    count[k] = 0;
-                    value[k] =
-                        hit.quad < 0 ? 0.0f : shade(hit.quad, dir, hit.t, hit.a, hit.b, angle);
-                    ++distinct;
-                  }
+                if (k == distinct && distinct == kMaxQuads) {
+                  k = 0;  // more quads than that in one pixel: count them as the centre's
+                } else if (k == distinct) {
+                  quad[k] = hit.quad;
+                  count[k] = 0;
+                  value[k] = hit.quad < 0 ? 0.0f : shade(hit.quad, dir, hit.t, hit.a, hit.b, angle);
+                  ++distinct;
                 }
                 ++count[k];
               }

@@ -43,16 +43,21 @@ class RadianceRenderer {
                    cv::Mat1i* quad_ids = nullptr) const;
 
  private:
-  static constexpr int kTile = 16;
+  static constexpr int kTile = 24;
   struct Tile {
     int u0, v0, u1, v1;
     Eigen::Vector3f normal_c[4];  ///< inward normals of the tile's pyramid, camera frame
     Eigen::Vector3f corner_c[4];  ///< the pyramid's corner rays (unit), camera frame
     float slack;                  ///< angular slack (rad) so that every ray is inside
   };
+  /// A quad that rays of a tile may hit, with what the ray test needs that depends
+  /// only on the camera centre o precomputed: a ray o + t d hits the quad's plane at
+  /// t = num / (n.d), at fractions a = a0 + t (u.d), b = b0 + t (v.d) along its edges.
   struct Candidate {
     float min_distance;  ///< no point of the quad is nearer to the camera
     int quad;
+    Eigen::Vector3f n, u_scaled, v_scaled;
+    float num, a0, b0;
   };
   struct Hit {
     int quad;  ///< -1: nothing hit
@@ -60,8 +65,7 @@ class RadianceRenderer {
   };
   void cullTile(const Tile& tile, const Eigen::Matrix3f& R, const Eigen::Vector3f& origin,
                 std::vector<Candidate>* out) const;
-  Hit intersect(const std::vector<Candidate>& candidates, const Eigen::Vector3f& origin,
-                const Eigen::Vector3f& dir) const;
+  Hit intersect(const std::vector<Candidate>& candidates, const Eigen::Vector3f& dir) const;
   float shade(int quad, const Eigen::Vector3f& dir, float t, float a, float b,
               float pixel_angle) const;
 

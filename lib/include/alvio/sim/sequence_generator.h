@@ -22,7 +22,7 @@ namespace alvio::sim {
 
 /// Bumped whenever the simulator's output for the same inputs changes, so that
 /// cached benchmark sequences are rebuilt.
-constexpr const char* kSimulatorVersion = "alvio-sim 3";
+constexpr const char* kSimulatorVersion = "alvio-sim 4";
 
 struct SequenceOptions {
   std::string scene;       ///< scene file or name; "" = the built-in machine hall
