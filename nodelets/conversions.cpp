@@ -134,7 +134,7 @@ Eigen::Isometry3d fromPose(const geometry_msgs::Pose& pose) {
                                   pose.orientation.z)
                    .normalized()
                    .toRotationMatrix();
-  T.translation() = {pose.position.x, pose.position.y, pose.position.z};
+  T.translation() = Eigen::Vector3d(pose.position.x, pose.position.y, pose.position.z);
   return T;
 }
 

@@ -9,11 +9,11 @@
 #include <nav_msgs/Odometry.h>
 #include <nav_msgs/Path.h>
 #include <nodelet/nodelet.h>
-#include <pluginlib/class_list_macros.hpp>
 #include <ros/ros.h>
 #include <tf2_ros/static_transform_broadcaster.h>
 #include <tf2_ros/transform_broadcaster.h>
 #include <visualization_msgs/MarkerArray.h>
+#include <pluginlib/class_list_macros.hpp>
 
 #include <alvio/MapKeyframe.h>
 #include <alvio/PipelineStatus.h>
@@ -222,8 +222,8 @@ class EstimatorNodelet : public nodelet::Nodelet {
     auto status = boost::make_shared<alvio::PipelineStatus>();
     status->header = header;
     status->state = estimator_->resetCount() != resets_before ? alvio::PipelineStatus::RESET
-                    : has_pose ? alvio::PipelineStatus::TRACKING
-                               : alvio::PipelineStatus::INITIALISING;
+                    : has_pose                                ? alvio::PipelineStatus::TRACKING
+                                                              : alvio::PipelineStatus::INITIALISING;
     status->message = last_event_;
     status->reset_count = estimator_->resetCount();
     status->frames = frames_;

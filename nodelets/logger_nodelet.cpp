@@ -6,11 +6,11 @@
 #include <geometry_msgs/PoseArray.h>
 #include <nav_msgs/Odometry.h>
 #include <nodelet/nodelet.h>
-#include <pluginlib/class_list_macros.hpp>
 #include <ros/ros.h>
 #include <sensor_msgs/Imu.h>
 #include <sensor_msgs/PointCloud2.h>
 #include <visualization_msgs/MarkerArray.h>
+#include <pluginlib/class_list_macros.hpp>
 
 #include <alvio/PipelineStatus.h>
 
@@ -64,14 +64,15 @@ class LoggerNodelet : public nodelet::Nodelet {
     logger_ = std::make_unique<alvio::MrptLogger>(c.logger, c.camera, output_dir);
 
     std::ostringstream os;
-    os << "alvio nodelets\n  config: " << config.describe() << "\n  camera: "
-       << c.camera.distortion_model << " " << c.camera.width << "x" << c.camera.height << " @ "
-       << c.camera.rate_hz << " Hz\n  topics: " << imu_topic << ", " << frame_topic << ", "
-       << estimator_ns << "/{odometry,status,window,points,lines}";
+    os << "alvio nodelets\n  config: " << config.describe()
+       << "\n  camera: " << c.camera.distortion_model << " " << c.camera.width << "x"
+       << c.camera.height << " @ " << c.camera.rate_hz << " Hz\n  topics: " << imu_topic << ", "
+       << frame_topic << ", " << estimator_ns << "/{odometry,status,window,points,lines}";
     logger_->log(alvio::LogLevel::kInfo, os.str());
     alvio::MrptLogger* logger = logger_.get();
-    log_route_.setListener(
-        [logger](alvio::LogLevel level, const std::string& message) { logger->log(level, message); });
+    log_route_.setListener([logger](alvio::LogLevel level, const std::string& message) {
+      logger->log(level, message);
+    });
 
     imu_sub_ = nh.subscribe(imu_topic, 2000, &LoggerNodelet::onImu, this);
     frame_sub_ = nh.subscribe(frame_topic, 20, &LoggerNodelet::onFrame, this);
@@ -83,7 +84,8 @@ class LoggerNodelet : public nodelet::Nodelet {
     const alvio::LoggerPaths& p = logger_->paths();
     NODELET_INFO("logging into %s (rawlog %s, scene %s, text %s)", output_dir.c_str(),
                  p.rawlog.empty() ? "off" : p.rawlog.c_str(),
-                 p.scene.empty() ? "off" : p.scene.c_str(), p.text.empty() ? "off" : p.text.c_str());
+                 p.scene.empty() ? "off" : p.scene.c_str(),
+                 p.text.empty() ? "off" : p.text.c_str());
   }
 
   void onImu(const sensor_msgs::ImuConstPtr& msg) { logger_->addImu(fromMsg(*msg)); }
@@ -103,7 +105,8 @@ class LoggerNodelet : public nodelet::Nodelet {
   void onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
     ++poses_;
     const Eigen::Isometry3d T = fromPose(msg->pose.pose);
-    logger_->addPose({msg->header.stamp.toSec(), T.translation(), Eigen::Quaterniond(T.rotation())});
+    logger_->addPose(
+        {msg->header.stamp.toSec(), T.translation(), Eigen::Quaterniond(T.rotation())});
   }
 
   void onStatus(const alvio::PipelineStatus::ConstPtr& msg) {

@@ -3,11 +3,11 @@
 // publish_period), saves it on ~save_map and on shutdown into output_dir.
 #include <nav_msgs/Odometry.h>
 #include <nodelet/nodelet.h>
-#include <pluginlib/class_list_macros.hpp>
 #include <ros/ros.h>
 #include <sensor_msgs/PointCloud2.h>
 #include <std_srvs/Trigger.h>
 #include <visualization_msgs/MarkerArray.h>
+#include <pluginlib/class_list_macros.hpp>
 
 #include <alvio/MapKeyframe.h>
 
@@ -94,7 +94,8 @@ class MappingNodelet : public nodelet::Nodelet {
     Segments segments;
     for (const auto& l : map_->lineMap().filteredLines()) segments.emplace_back(l.p0, l.p1);
     auto markers = boost::make_shared<visualization_msgs::MarkerArray>();
-    markers->markers.push_back(lineListMarker(segments, header, "map_lines", 1.0f, 0.6f, 0.1f, 0.03));
+    markers->markers.push_back(
+        lineListMarker(segments, header, "map_lines", 1.0f, 0.6f, 0.1f, 0.03));
     lines_pub_.publish(markers);
     auto cloud = boost::make_shared<sensor_msgs::PointCloud2>();
     toCloud(alvio::occupiedVoxelCentres(map_->occupancyMap().tree()), header, cloud.get());

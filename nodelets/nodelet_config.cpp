@@ -110,8 +110,11 @@ void NodeletConfig::rejectUnusedOverrides() const {
   const auto unknown = yaml_->unknownKeys();
   std::string bad;
   for (const auto& key : override_keys_)
-    if (std::find(unknown.begin(), unknown.end(), key) != unknown.end())
-      bad += (bad.empty() ? "" : ", ") + overrides_param_ + "/" + key;
+    if (std::find(unknown.begin(), unknown.end(), key) != unknown.end()) {
+      std::string name = key;  // as the parameter is spelt
+      std::replace(name.begin(), name.end(), '.', '/');
+      bad += (bad.empty() ? "" : ", ") + overrides_param_ + "/" + name;
+    }
   if (!bad.empty())
     throw alvio::Error("unknown configuration key(s) in ROS parameters: " + bad + " (misspelt?)");
 }
@@ -125,13 +128,12 @@ std::string NodeletConfig::describe() const {
 bool param(const ros::NodeHandle& nh, const std::string& name, bool fallback) {
   XmlRpcValue v;
   return fetch(nh, name, &v, {XmlRpcValue::TypeBoolean}, "a boolean") ? static_cast<bool>(v)
-                                                                        : fallback;
+                                                                      : fallback;
 }
 
 int param(const ros::NodeHandle& nh, const std::string& name, int fallback) {
   XmlRpcValue v;
-  return fetch(nh, name, &v, {XmlRpcValue::TypeInt}, "an integer") ? static_cast<int>(v)
-                                                                   : fallback;
+  return fetch(nh, name, &v, {XmlRpcValue::TypeInt}, "an integer") ? static_cast<int>(v) : fallback;
 }
 
 double param(const ros::NodeHandle& nh, const std::string& name, double fallback) {

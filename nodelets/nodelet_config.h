@@ -54,8 +54,7 @@ bool param(const ros::NodeHandle& nh, const std::string& name, bool fallback);
 int param(const ros::NodeHandle& nh, const std::string& name, int fallback);
 double param(const ros::NodeHandle& nh, const std::string& name, double fallback);
 std::string param(const ros::NodeHandle& nh, const std::string& name, const std::string& fallback);
-inline std::string param(const ros::NodeHandle& nh, const std::string& name,
-                         const char* fallback) {
+inline std::string param(const ros::NodeHandle& nh, const std::string& name, const char* fallback) {
   return param(nh, name, std::string(fallback));
 }
 

@@ -5,8 +5,8 @@
 #include <cv_bridge/cv_bridge.h>
 #include <image_transport/image_transport.h>
 #include <nodelet/nodelet.h>
-#include <pluginlib/class_list_macros.hpp>
 #include <ros/ros.h>
+#include <pluginlib/class_list_macros.hpp>
 
 #include <alvio/PipelineStatus.h>
 
@@ -51,12 +51,12 @@ class TrackerNodelet : public nodelet::Nodelet {
     frame_pub_ = pnh.advertise<SharedTrackedFrame>("frame", 10);
     status_sub_ = nh.subscribe(status_topic, 10, &TrackerNodelet::onStatus, this);
     transport_ = std::make_unique<image_transport::ImageTransport>(nh);
-    image_sub_ = transport_->subscribe(image_topic, queue, &TrackerNodelet::onImage, this,
-                              image_transport::TransportHints(transport, ros::TransportHints(), pnh));
+    image_sub_ = transport_->subscribe(
+        image_topic, queue, &TrackerNodelet::onImage, this,
+        image_transport::TransportHints(transport, ros::TransportHints(), pnh));
     NODELET_INFO("tracking %s (%s) with %s; points%s; publishing %s", image_sub_.getTopic().c_str(),
                  transport.c_str(), config.describe().c_str(),
-                 front_end_->tracksLines() ? " and lines" : " only",
-                 frame_pub_.getTopic().c_str());
+                 front_end_->tracksLines() ? " and lines" : " only", frame_pub_.getTopic().c_str());
   }
 
   void onImage(const sensor_msgs::ImageConstPtr& image) {

@@ -4,9 +4,9 @@
 // topic); in another process, or behind a copying transport, frames are `copied`.
 // Used by the integration test; handy to verify a robot's launch file.
 #include <nodelet/nodelet.h>
-#include <pluginlib/class_list_macros.hpp>
 #include <ros/ros.h>
 #include <sensor_msgs/Image.h>
+#include <pluginlib/class_list_macros.hpp>
 
 #include <alvio/ZeroCopyReport.h>
 

@@ -94,9 +94,9 @@ void playOnce() {
   const std::string estimator = s.ns + "/estimator/odometry", frame = s.ns + "/tracker/frame";
   ASSERT_TRUE(waitFor([&] { return advertised(estimator) && advertised(frame); }, 60))
       << "the tracker and estimator did not come up";
-  if (!s.manager.empty())
-    for (const auto& name : s.nodelets)
-      ASSERT_TRUE(waitFor([&] { return listed(name); }, 60)) << name << " was not loaded";
+  for (const auto& name : s.nodelets) {
+    ASSERT_TRUE(waitFor([&] { return listed(name); }, 60)) << name << " was not loaded";
+  }
   ros::WallDuration(1.0).sleep();  // subscriptions follow the advertisements
 
   ASSERT_TRUE(ros::service::waitForService(s.player + "/pause_playback", ros::Duration(30)));
@@ -134,9 +134,11 @@ alvio::Trajectory recordedTrajectory() {
   return t;
 }
 
-#define REQUIRE_DATA()                                                        \
-  if (!g_unavailable.empty()) GTEST_SKIP() << "no test data: " << g_unavailable; \
-  playOnce();                                                                 \
+#define REQUIRE_DATA()                                 \
+  if (!g_unavailable.empty()) {                        \
+    GTEST_SKIP() << "no test data: " << g_unavailable; \
+  }                                                    \
+  playOnce();                                          \
   if (HasFatalFailure()) return
 
 }  // namespace
@@ -147,16 +149,17 @@ TEST(NodeletPipeline, OdometryAndTfArriveAtTheImageRateWithImageStamps) {
   ASSERT_FALSE(g_rec.odometry.empty()) << "no odometry: the estimator never initialised";
   const int64_t first = g_rec.odometry.front().first, last = g_rec.odometry.back().first;
   const std::set<int64_t> image_stamps(g_rec.images.begin(), g_rec.images.end());
-  const auto after = static_cast<double>(
-      std::count_if(g_rec.images.begin(), g_rec.images.end(), [&](int64_t t) { return t >= first; }));
+  const auto after = static_cast<double>(std::count_if(g_rec.images.begin(), g_rec.images.end(),
+                                                       [&](int64_t t) { return t >= first; }));
   const auto tf_after = static_cast<double>(
       std::count_if(g_rec.tf.begin(), g_rec.tf.end(), [&](int64_t t) { return t >= first; }));
   const double odometry = static_cast<double>(g_rec.odometry.size());
   std::cout << "images " << g_rec.images.size() << ", after initialisation " << after
             << ", odometry " << odometry << ", TF " << tf_after << ", initialised "
-            << (first - g_rec.images.front()) * 1e-9 << " s after the first image, status: "
-            << g_rec.status.frames << " frames, " << g_rec.status.dropped_frames
-            << " dropped, " << g_rec.status.reset_count << " resets\n";
+            << (first - g_rec.images.front()) * 1e-9
+            << " s after the first image, status: " << g_rec.status.frames << " frames, "
+            << g_rec.status.dropped_frames << " dropped, " << g_rec.status.reset_count
+            << " resets\n";
   EXPECT_GE(odometry, 0.95 * after) << "odometry must follow every image once initialised";
   EXPECT_GE(tf_after, 0.95 * after);
   const double rate = (odometry - 1) / ((last - first) * 1e-9);
@@ -227,7 +230,7 @@ bool nonEmptyFile(const std::string& path) {
   return fs::is_regular_file(path) && fs::file_size(path) > 0;
 }
 
-// A FATAL rosout message from `node` mentioning `text`.
+// A FATAL message on /rosout (rostest runs no aggregator) about `node`, mentioning `text`.
 bool fatalLogged(const std::string& node, const std::string& text) {
   std::lock_guard<std::mutex> lock(g_rec.mutex);
   return std::any_of(g_rec.log.begin(), g_rec.log.end(), [&](const rosgraph_msgs::Log& m) {
@@ -342,9 +345,11 @@ int main(int argc, char** argv) {
       nh.subscribe<nav_msgs::Odometry>(s.ns + "/estimator/odometry", 1000, onOdometry,
                                        ros::VoidConstPtr(), hints),
       nh.subscribe<tf2_msgs::TFMessage>("/tf", 1000, onTf, ros::VoidConstPtr(), hints),
-      nh.subscribe<alvio::PipelineStatus>(s.ns + "/estimator/status", 100, onStatus),
-      nh.subscribe<alvio::ZeroCopyReport>(s.ns + "/zero_copy_monitor/report", 10, onReport),
-      nh.subscribe<rosgraph_msgs::Log>("/rosout_agg", 1000, onLog)};
+      nh.subscribe<alvio::PipelineStatus>(s.ns + "/estimator/status", 100, onStatus,
+                                          ros::VoidConstPtr(), hints),
+      nh.subscribe<alvio::ZeroCopyReport>(s.ns + "/zero_copy_monitor/report", 10, onReport,
+                                          ros::VoidConstPtr(), hints),
+      nh.subscribe<rosgraph_msgs::Log>("/rosout", 1000, onLog, ros::VoidConstPtr(), hints)};
   ros::AsyncSpinner spinner(2);
   spinner.start();
   const int result = RUN_ALL_TESTS();

@@ -138,7 +138,8 @@ TEST(RosMessages, MapKeyframeFiltersLinesByDirectionUncertainty) {
   kf.t = 1600000002.5;
   kf.T_w_c = Eigen::Translation3d(1, 2, 3) * Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ());
   kf.points = {{1, {1, 1, 1}}, {2, {2, 2, 2}}};
-  kf.lines = {{5, {0, 0, 0}, {1, 0, 0}, 6}, {6, {0, 0, 1}, {0, 1, 1}, 9}, {7, {0, 0, 2}, {1, 1, 2}, 3}};
+  kf.lines = {
+      {5, {0, 0, 0}, {1, 0, 0}, 6}, {6, {0, 0, 1}, {0, 1, 1}, 9}, {7, {0, 0, 2}, {1, 1, 2}, 3}};
   std_msgs::Header header;
   header.stamp.fromSec(kf.t);
   alvio::MapKeyframe msg;

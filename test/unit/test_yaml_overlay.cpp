@@ -23,8 +23,9 @@ TEST(YamlOverlay, ReplacesLeavesAndKeepsTheRest) {
 }
 
 TEST(YamlOverlay, LeafKeysAreDottedPaths) {
-  const auto keys = yamlLeafKeys("estimator:\n  window_size: 8\n  line_triangulation:\n"
-                                 "    min_plane_angle_deg: 2\npoints:\n  max_features: 100\n");
+  const auto keys = yamlLeafKeys(
+      "estimator:\n  window_size: 8\n  line_triangulation:\n"
+      "    min_plane_angle_deg: 2\npoints:\n  max_features: 100\n");
   EXPECT_EQ(keys, (std::vector<std::string>{"estimator.window_size",
                                             "estimator.line_triangulation.min_plane_angle_deg",
                                             "points.max_features"}));

@@ -3,7 +3,9 @@
 namespace alvio {
 
 VioPipeline::VioPipeline(const Config& config)
-    : config_(config), front_end_(config), estimator_(config.estimator, config.camera, config.imu) {}
+    : config_(config),
+      front_end_(config),
+      estimator_(config.estimator, config.camera, config.imu) {}
 
 PipelineOutput VioPipeline::addImage(const cv::Mat& gray, int64_t t_ns) {
   PipelineOutput out;

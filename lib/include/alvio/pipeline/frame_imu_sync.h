@@ -19,8 +19,8 @@
 namespace alvio {
 
 struct FrameImuSyncOptions {
-  std::size_t max_frames = 20;   ///< frames waiting for IMU or for the estimator (1 s at 20 Hz)
-  std::size_t max_imu = 4000;    ///< IMU samples waiting for a frame (20 s at 200 Hz)
+  std::size_t max_frames = 20;  ///< frames waiting for IMU or for the estimator (1 s at 20 Hz)
+  std::size_t max_imu = 4000;   ///< IMU samples waiting for a frame (20 s at 200 Hz)
 };
 
 struct FrameImuSyncCounts {
