@@ -14,6 +14,7 @@
 
 #include <alvio/PipelineStatus.h>
 
+#include <filesystem>
 #include <memory>
 #include <sstream>
 
@@ -61,7 +62,8 @@ class LoggerNodelet : public nodelet::Nodelet {
     requireParam(!output_dir.empty(), pnh, "output_dir",
                  "is not set (nor logger.out_dir in the configuration): nowhere to log");
     c.logger.validate(config.describe() + ": logger");
-    logger_ = std::make_unique<alvio::MrptLogger>(c.logger, c.camera, output_dir);
+    logger_ =
+        std::make_unique<alvio::MrptLogger>(freshNames(c.logger, output_dir), c.camera, output_dir);
 
     std::ostringstream os;
     os << "alvio nodelets\n  config: " << config.describe()
@@ -86,6 +88,23 @@ class LoggerNodelet : public nodelet::Nodelet {
                  p.rawlog.empty() ? "off" : p.rawlog.c_str(),
                  p.scene.empty() ? "off" : p.scene.c_str(),
                  p.text.empty() ? "off" : p.text.c_str());
+  }
+
+  // A robot's earlier run, or this nodelet before a reload, may have logged into the same
+  // folder: never overwrite it, number the new files instead (alvio_1.rawlog, alvio_1.log).
+  static alvio::LoggerOptions freshNames(alvio::LoggerOptions options, const std::string& dir) {
+    const std::string name = options.name, text = options.text_file;
+    const auto stem = std::filesystem::path(text).stem().string();
+    const auto ext = std::filesystem::path(text).extension().string();
+    for (int n = 1;; ++n) {
+      const std::filesystem::path d(options.out_dir.empty() ? dir : options.out_dir);
+      if (!std::filesystem::exists(d / (options.name + ".rawlog")) &&
+          !std::filesystem::exists(d / (options.name + ".3Dscene")) &&
+          !std::filesystem::exists(d / options.text_file))
+        return options;
+      options.name = name + "_" + std::to_string(n);
+      options.text_file = stem + "_" + std::to_string(n) + ext;
+    }
   }
 
   void onImu(const sensor_msgs::ImuConstPtr& msg) { logger_->addImu(fromMsg(*msg)); }

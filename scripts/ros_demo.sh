@@ -13,7 +13,7 @@ set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BUILD="${ALVIO_BUILD_DIR:-$ROOT/build}"
 BIN="$BUILD/devel/lib/alvio"
-rate=1.0
+rate=0.5  # the front end needs ~45 ms per frame on 2 busy cores: real time is too tight
 out="$ROOT/out/ros-demo"
 while [[ $# -gt 0 ]]; do
   case "$1" in

@@ -39,9 +39,9 @@ if [[ ! -f $out/sim.bag || ! -f $out/groundtruth.tum || "$(cat "$out/source.txt"
   rm -rf "$out/offline"
 fi
 
-# The offline reference: redone when the bag or any program or library was rebuilt.
-newest_build=$(find "$bin" "$bin/.." -maxdepth 1 -type f -newer "$out/offline/trajectory.tum" \
-  -name '*alvio*' 2>/dev/null | head -1 || true)
+# The offline reference: redone when the bag, alvio_run or a library it uses was rebuilt.
+newest_build=$(find "$bin/alvio_run" "$bin/.."/libalvio_{core,mapping,logging}.so \
+  -newer "$out/offline/trajectory.tum" 2>/dev/null | head -1 || true)
 if [[ ! -f $out/offline/trajectory.tum || -n $newest_build ]]; then
   rm -rf "$out/offline"
   "$bin/alvio_run" --dataset "$out/sim.bag" --out "$out/offline" --quiet --no-log >"$out/offline.txt" 2>&1 ||

@@ -56,6 +56,7 @@ struct Recording {
 
 Settings g_settings;
 Recording g_rec;
+const fs::file_time_type g_start = fs::file_time_type::clock::now();
 bool g_played = false;
 std::string g_unavailable;
 
@@ -226,8 +227,10 @@ bool load(const std::string& name, const std::string& type) {
   return ros::service::call(g_settings.manager + "/load_nodelet", srv) && srv.response.success;
 }
 
-bool nonEmptyFile(const std::string& path) {
-  return fs::is_regular_file(path) && fs::file_size(path) > 0;
+// Written (closed) while this test ran, not left over from an earlier run.
+bool writtenNow(const std::string& path) {
+  return fs::is_regular_file(path) && fs::file_size(path) > 0 &&
+         fs::last_write_time(path) > g_start;
 }
 
 // A FATAL message on /rosout (rostest runs no aggregator) about `node`, mentioning `text`.
@@ -257,7 +260,7 @@ TEST(NodeletPipeline, NodeletsUnloadWritingTheirFilesAndReload) {
   EXPECT_EQ(written.size(), recordedTrajectory().size()) << "trajectory.tum vs odometry";
   for (const char* f : {"octomap.bt", "lines.csv", "lines.ply", "map.3Dscene", "alvio.rawlog",
                         "alvio.3Dscene", "alvio.log"})
-    EXPECT_TRUE(nonEmptyFile(out + "/" + f)) << f << " was not written into " << out;
+    EXPECT_TRUE(writtenNow(out + "/" + f)) << f << " was not written into " << out;
 
   for (const auto& [name, type] : nodelets) EXPECT_TRUE(load(name, type)) << name;
   for (const auto& [name, type] : nodelets) EXPECT_TRUE(listed(name)) << name;
