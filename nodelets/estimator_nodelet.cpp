@@ -93,6 +93,7 @@ class EstimatorNodelet : public nodelet::Nodelet {
     sync_ = Sync(sync_options);
 
     T_b_c_ = c.camera.T_b_c;
+    config_ = c;
     estimator_ = std::make_unique<alvio::Estimator>(c.estimator, c.camera, c.imu);
     feed_ = std::make_unique<alvio::EstimatorKeyframeFeed>(c.camera.T_b_c);
     path_.header.frame_id = world_frame_;
@@ -136,8 +137,10 @@ class EstimatorNodelet : public nodelet::Nodelet {
     std::size_t dropped = 0;
     {
       std::lock_guard<std::mutex> lock(mutex_);
+      const alvio::ImuSample sample = fromMsg(*msg);
+      jumpedBack(sample.t_ns);
       const std::size_t before = sync_.counts().droppedImu();
-      sync_.addImu(fromMsg(*msg));
+      sync_.addImu(sample);
       dropped = sync_.counts().droppedImu() - before;
     }
     if (dropped)
@@ -152,8 +155,15 @@ class EstimatorNodelet : public nodelet::Nodelet {
     std::size_t late = 0, overflow = 0;
     {
       std::lock_guard<std::mutex> lock(mutex_);
+      const int64_t t_ns = toNs(msg->features.header.stamp);
+      if (newest_ns_ != 0 && t_ns > newest_ns_ + kJumpBackNs) {
+        // Tracked before the time jump that restarted the run: not part of the new run.
+        NODELET_WARN_THROTTLE(2.0, "frame at %.3f s is over 1 s ahead of the IMU: dropped",
+                              t_ns * 1e-9);
+        return;
+      }
       const auto before = sync_.counts();
-      sync_.addFrame(toNs(msg->features.header.stamp), msg);
+      sync_.addFrame(t_ns, msg);
       late = sync_.counts().frames_late - before.frames_late;
       overflow = sync_.counts().frames_overflow - before.frames_overflow;
     }
@@ -168,9 +178,40 @@ class EstimatorNodelet : public nodelet::Nodelet {
     wake_.notify_one();
   }
 
+  // IMU time going back by more than a second (a bag played again, a restarted simulation)
+  // starts a new run: the queues are emptied now, the estimator restarted by the worker.
+  // The IMU decides, as it comes straight from the sensor; frames lag behind the tracker.
+  // Called under mutex_.
+  void jumpedBack(int64_t t_ns) {
+    if (newest_ns_ != 0 && t_ns + kJumpBackNs < newest_ns_) {
+      sync_ = Sync(sync_.options());
+      restart_ = true;
+      newest_ns_ = t_ns;
+    }
+    newest_ns_ = std::max(newest_ns_, t_ns);
+  }
+
+  void restart() {
+    NODELET_WARN("time jumped back: the estimator starts a new run (trajectory and path too)");
+    estimator_ = std::make_unique<alvio::Estimator>(config_.estimator, config_.camera, config_.imu);
+    feed_ = std::make_unique<alvio::EstimatorKeyframeFeed>(config_.camera.T_b_c);
+    trajectory_.clear();
+    path_.poses.clear();
+    last_event_.clear();
+    frames_ = 0;
+    flushed_ = false;
+  }
+
   void run() {
     std::unique_lock<std::mutex> lock(mutex_);
     while (!stop_) {
+      if (restart_) {
+        restart_ = false;
+        lock.unlock();
+        restart();
+        lock.lock();
+        continue;
+      }
       std::optional<Sync::Ready> ready = sync_.pop();
       if (!ready) {
         wake_.wait_for(lock, std::chrono::milliseconds(200));
@@ -358,12 +399,15 @@ class EstimatorNodelet : public nodelet::Nodelet {
   int path_max_poses_ = 10000;
   double flush_after_s_ = 1.0, line_max_std_deg_ = -1;
   Eigen::Isometry3d T_b_c_ = Eigen::Isometry3d::Identity();
+  alvio::Config config_;
 
   // Shared between the callbacks and the worker (under mutex_).
   std::mutex mutex_;
   std::condition_variable wake_;
   Sync sync_;
-  bool stop_ = false;
+  bool stop_ = false, restart_ = false;
+  int64_t newest_ns_ = 0;  // newest IMU stamp
+  static constexpr int64_t kJumpBackNs = 1000000000;
 
   // The worker's.
   std::thread worker_;

@@ -45,7 +45,8 @@ class TrackerNodelet : public nodelet::Nodelet {
     requireParam(!image_topic.empty(), pnh, "image_topic", "is empty");
     requireParam(queue > 0, pnh, "queue_size", "must be positive");
 
-    front_end_ = std::make_unique<alvio::FrontEnd>(config.config());
+    config_ = config.config();
+    front_end_ = std::make_unique<alvio::FrontEnd>(config_);
     frame_period_ns_ = static_cast<int64_t>(1e9 / config.config().camera.rate_hz);
 
     frame_pub_ = pnh.advertise<SharedTrackedFrame>("frame", 10);
@@ -70,6 +71,13 @@ class TrackerNodelet : public nodelet::Nodelet {
       return;
     }
     const int64_t t_ns = toNs(image->header.stamp);
+    if (last_t_ns_ != 0 && t_ns + kJumpBackNs < last_t_ns_) {
+      // A bag played again, or a restarted simulation: a new run.
+      NODELET_WARN("time jumped back %.1f s: the front end starts afresh",
+                   (last_t_ns_ - t_ns) * 1e-9);
+      front_end_ = std::make_unique<alvio::FrontEnd>(config_);
+      last_t_ns_ = 0;
+    }
     if (last_t_ns_ != 0 && t_ns <= last_t_ns_) {
       NODELET_WARN_THROTTLE(5.0, "image stamps go back in time (%.3f s after %.3f s): skipped",
                             t_ns * 1e-9, last_t_ns_ * 1e-9);
@@ -95,13 +103,15 @@ class TrackerNodelet : public nodelet::Nodelet {
 
   // After an estimator reset the point tracks start afresh, as in the offline pipeline.
   void onStatus(const alvio::PipelineStatus::ConstPtr& status) {
-    if (status->reset_count > reset_count_) {
-      reset_count_ = status->reset_count;
-      reset_pending_ = true;
-    }
+    // Fewer resets than before: the estimator was restarted (reloaded, new run).
+    if (status->reset_count > reset_count_) reset_pending_ = true;
+    reset_count_ = status->reset_count;
   }
 
+  static constexpr int64_t kJumpBackNs = 1000000000;
+
   CoreLogRoute log_route_;
+  alvio::Config config_;
   std::unique_ptr<alvio::FrontEnd> front_end_;
   std::unique_ptr<image_transport::ImageTransport> transport_;
   image_transport::Subscriber image_sub_;
