@@ -375,9 +375,14 @@ class EstimatorNodelet : public nodelet::Nodelet {
   // When the frames stop (end of a bag, camera gone), the window's landmarks are the best
   // estimates there will be: hand them to the map, as the offline runner does at its end.
   void flushWindowToMap() {
-    for (const auto& keyframe : feed_->flush(*estimator_))
+    const auto keyframes = feed_->flush(*estimator_);
+    for (const auto& keyframe : keyframes)
       publishKeyframe(keyframe, {}, alvio::MapKeyframe::KEYFRAME_POINTS);
     flushed_ = true;
+    if (!keyframes.empty())
+      NODELET_INFO(
+          "no frame for %.1f s: the landmarks of the window's %zu keyframes went to the map",
+          flush_after_s_, keyframes.size());
   }
 
   void writeTrajectory() {

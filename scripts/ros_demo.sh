@@ -72,7 +72,19 @@ rosparam get /rosdistro >/dev/null 2>&1 || die "roscore did not start (see $out/
 log "playing $(basename "$bag") at rate $rate through the nodelet pipeline (master $ROS_MASTER_URI)"
 start=$(date +%s)
 roslaunch alvio sim.launch bag:="$bag" rate:="$rate" output_dir:="$run" logging:=true \
-  >"$out/roslaunch.log" 2>&1 || die "roslaunch failed (see $out/roslaunch.log)"
+  exit_at_end:=false >"$out/roslaunch.log" 2>&1 &
+launch_pid=$!
+trap 'kill -INT "$launch_pid" 2>/dev/null || true; kill "$core_pid" 2>/dev/null || true; wait 2>/dev/null || true' EXIT
+# The player appears, plays and leaves; then the estimator gets 1 s without frames to hand
+# the window to the map (flush_after_s) before the pipeline shuts down and writes its files.
+for _ in $(seq 150); do rosnode list 2>/dev/null | grep -q '^/player$' && break; sleep 0.2; done
+while rosnode list 2>/dev/null | grep -q '^/player$'; do
+  kill -0 "$launch_pid" 2>/dev/null || die "roslaunch ended early (see $out/roslaunch.log)"
+  sleep 1
+done
+sleep 3
+kill -INT "$launch_pid"
+wait "$launch_pid" || true
 log "pipeline finished in $(($(date +%s) - start)) s"
 
 [[ -s $run/trajectory.tum ]] || die "no trajectory written (see $out/roslaunch.log)"
