@@ -8,9 +8,12 @@
 namespace alvio {
 
 Config Config::load(const std::string& path) {
-  YamlReader yaml(path);
+  return load(YamlReader(path));
+}
+
+Config Config::load(const YamlReader& yaml) {
   Config c;
-  c.source = path;
+  c.source = yaml.path();
   c.camera = CameraOptions::load(yaml, "camera");
   c.imu = ImuOptions::load(yaml, "imu");
   c.topics = TopicOptions::load(yaml, "topics");

@@ -12,6 +12,8 @@
 
 namespace alvio {
 
+class YamlReader;
+
 struct Config {
   std::string source;  ///< the file it was loaded from ("" for defaults)
   CameraOptions camera;
@@ -25,6 +27,9 @@ struct Config {
   /// Load and validate `path`. Missing/malformed keys throw alvio::Error naming
   /// file and key; unknown keys are logged as warnings.
   static Config load(const std::string& path);
+  /// The same from YAML already read (e.g. a file with ROS parameter overrides merged in);
+  /// `source` becomes yaml.path().
+  static Config load(const YamlReader& yaml);
   /// The configuration shipped as config/euroc.yaml, found next to the sources or installed.
   static std::string defaultPath();
 };

@@ -11,8 +11,7 @@
 #include "alvio/common/timing.h"
 #include "alvio/config/config.h"
 #include "alvio/estimator/estimator.h"
-#include "alvio/frontend/point_tracker.h"
-#include "alvio/lines/line_tracker.h"
+#include "alvio/pipeline/front_end.h"
 
 namespace alvio {
 
@@ -41,13 +40,11 @@ class VioPipeline {
   PipelineOutput addImage(const cv::Mat& gray, int64_t t_ns);
 
   const Estimator& estimator() const { return estimator_; }
-  const CameraModel& camera() const { return *camera_; }
+  const CameraModel& camera() const { return front_end_.camera(); }
 
  private:
   Config config_;
-  std::shared_ptr<const CameraModel> camera_;
-  PointTracker point_tracker_;
-  std::unique_ptr<LineTracker> line_tracker_;  // null when lines are off
+  FrontEnd front_end_;
   Estimator estimator_;
 };
 

@@ -1,0 +1,25 @@
+#pragma once
+// Configuration overrides: a YAML mapping laid over a configuration file, key by
+// key. The nodelets turn their `config` ROS parameters into such a mapping, so
+// that a ROS parameter overrides the same key of the YAML file and is validated
+// by the same loaders, with the same errors naming the key.
+
+#include <string>
+#include <vector>
+
+namespace alvio {
+
+/// `base` (YAML text) with every leaf of `overlay` (YAML text of a mapping) replacing or
+/// adding the same dotted key. Nested mappings merge; anything else replaces. Throws
+/// alvio::Error naming `base_name` or `overlay_name` on a syntax error, or when an overlay
+/// key would descend into a value that is not a mapping.
+std::string overlayYaml(const std::string& base, const std::string& base_name,
+                        const std::string& overlay, const std::string& overlay_name);
+
+/// Dotted paths of the leaves (non-mapping values) of a YAML mapping text.
+std::vector<std::string> yamlLeafKeys(const std::string& text);
+
+/// The contents of a text file; throws alvio::Error naming it when it cannot be read.
+std::string readTextFile(const std::string& path);
+
+}  // namespace alvio

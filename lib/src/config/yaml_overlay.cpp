@@ -1,0 +1,88 @@
+#include "alvio/config/yaml_overlay.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <fstream>
+#include <sstream>
+
+#include "alvio/common/error.h"
+
+namespace alvio {
+
+namespace {
+
+// OpenCV's "%YAML:1.0" first line is not valid YAML (as in YamlReader).
+std::string withoutOpenCvHeader(const std::string& text) {
+  if (text.rfind("%YAML:", 0) != 0) return text;
+  const auto eol = text.find('\n');
+  return eol == std::string::npos ? std::string() : text.substr(eol);
+}
+
+YAML::Node parse(const std::string& text, const std::string& name) {
+  try {
+    return YAML::Load(withoutOpenCvHeader(text));
+  } catch (const YAML::Exception& e) {
+    throw Error(name + ": YAML syntax error at line " + std::to_string(e.mark.line + 1) + ": " +
+                e.msg);
+  }
+}
+
+void overlay(YAML::Node base, const YAML::Node& over, const std::string& prefix,
+             const std::string& overlay_name) {
+  for (const auto& kv : over) {
+    const std::string key = kv.first.as<std::string>();
+    const std::string path = prefix.empty() ? key : prefix + "." + key;
+    if (kv.second.IsMap()) {
+      if (base[key] && !base[key].IsMap() && !base[key].IsNull())
+        throw Error(overlay_name + ": key '" + path +
+                    "' is a group of keys, but the configuration file has a single value there");
+      if (!base[key] || base[key].IsNull()) base[key] = YAML::Node(YAML::NodeType::Map);
+      overlay(base[key], kv.second, path, overlay_name);
+    } else {
+      base[key] = kv.second;
+    }
+  }
+}
+
+void leaves(const YAML::Node& node, const std::string& prefix, std::vector<std::string>* out) {
+  if (!node.IsMap()) {
+    if (!prefix.empty()) out->push_back(prefix);
+    return;
+  }
+  for (const auto& kv : node) {
+    const std::string key = kv.first.as<std::string>();
+    leaves(kv.second, prefix.empty() ? key : prefix + "." + key, out);
+  }
+}
+
+}  // namespace
+
+std::string overlayYaml(const std::string& base, const std::string& base_name,
+                        const std::string& overlay_text, const std::string& overlay_name) {
+  YAML::Node root = parse(base, base_name);
+  const YAML::Node over = parse(overlay_text, overlay_name);
+  if (over.IsNull()) return base;
+  if (!over.IsMap()) throw Error(overlay_name + ": expected a mapping of keys");
+  if (root.IsNull()) root = YAML::Node(YAML::NodeType::Map);
+  if (!root.IsMap()) throw Error(base_name + ": expected a mapping of keys at the top level");
+  overlay(root, over, "", overlay_name);
+  YAML::Emitter out;
+  out << root;
+  return out.c_str();
+}
+
+std::vector<std::string> yamlLeafKeys(const std::string& text) {
+  std::vector<std::string> out;
+  leaves(parse(text, "overrides"), "", &out);
+  return out;
+}
+
+std::string readTextFile(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw Error("cannot read '" + path + "'");
+  std::ostringstream buffer;
+  buffer << in.rdbuf();
+  return buffer.str();
+}
+
+}  // namespace alvio

@@ -1,0 +1,25 @@
+#include "alvio/pipeline/front_end.h"
+
+namespace alvio {
+
+FrontEnd::FrontEnd(const Config& config)
+    : camera_(CameraModel::create(config.camera)),
+      point_tracker_(config.points, camera_),
+      line_tracker_(config.estimator.use_lines ? createLineTracker(config.camera, config.lines)
+                                               : nullptr) {}
+
+FeatureFrame FrontEnd::track(const cv::Mat& gray, int64_t t_ns, FrameTiming* timing) {
+  FeatureFrame frame = point_tracker_.track(gray, t_ns, timing);
+  if (line_tracker_) {
+    LineFrame lines = line_tracker_->track(gray, t_ns * 1e-9);
+    frame.lines = std::move(lines.lines);
+    frame.line_stats = lines.stats;
+    if (timing) {
+      timing->add("line_detection", lines.stats.undistort_ms + lines.stats.detect_ms);
+      timing->add("line_tracking", lines.stats.track_ms);
+    }
+  }
+  return frame;
+}
+
+}  // namespace alvio

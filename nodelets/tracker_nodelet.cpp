@@ -1,0 +1,127 @@
+// alvio/TrackerNodelet: the visual front end. Subscribes to the camera through
+// image_transport, tracks points and lines (alvio::FrontEnd) and publishes ~frame:
+// the features together with the very image it received (SharedTrackedFrame), so
+// that the estimator and logger nodelets of the same manager get it without a copy.
+#include <cv_bridge/cv_bridge.h>
+#include <image_transport/image_transport.h>
+#include <nodelet/nodelet.h>
+#include <ros/ros.h>
+#include <pluginlib/class_list_macros.hpp>
+
+#include <alvio/PipelineStatus.h>
+
+#include <memory>
+
+#include "alvio/common/error.h"
+#include "alvio/pipeline/front_end.h"
+#include "conversions.h"
+#include "core_log_route.h"
+#include "nodelet_config.h"
+#include "shared_tracked_frame.h"
+
+namespace alvio_ros {
+
+class TrackerNodelet : public nodelet::Nodelet {
+ private:
+  void onInit() override {
+    try {
+      init();
+    } catch (const std::exception& e) {
+      // Thrown on: the manager unloads this nodelet and keeps running.
+      NODELET_FATAL("%s not loaded: %s", getName().c_str(), e.what());
+      throw;
+    }
+  }
+
+  void init() {
+    ros::NodeHandle& nh = getNodeHandle();
+    ros::NodeHandle& pnh = getPrivateNodeHandle();
+    const NodeletConfig config(nh, pnh);
+    config.rejectUnusedOverrides();
+    const std::string image_topic = param(pnh, "image_topic", config.config().topics.image);
+    const std::string transport = param(pnh, "image_transport", "raw");
+    const std::string status_topic = param(pnh, "status_topic", "estimator/status");
+    const int queue = param(pnh, "queue_size", 5);
+    requireParam(!image_topic.empty(), pnh, "image_topic", "is empty");
+    requireParam(queue > 0, pnh, "queue_size", "must be positive");
+
+    config_ = config.config();
+    front_end_ = std::make_unique<alvio::FrontEnd>(config_);
+    frame_period_ns_ = static_cast<int64_t>(1e9 / config.config().camera.rate_hz);
+
+    frame_pub_ = pnh.advertise<SharedTrackedFrame>("frame", 10);
+    status_sub_ = nh.subscribe(status_topic, 10, &TrackerNodelet::onStatus, this);
+    transport_ = std::make_unique<image_transport::ImageTransport>(nh);
+    image_sub_ = transport_->subscribe(
+        image_topic, queue, &TrackerNodelet::onImage, this,
+        image_transport::TransportHints(transport, ros::TransportHints(), pnh));
+    NODELET_INFO("tracking %s (%s) with %s; points%s; publishing %s", image_sub_.getTopic().c_str(),
+                 transport.c_str(), config.describe().c_str(),
+                 front_end_->tracksLines() ? " and lines" : " only", frame_pub_.getTopic().c_str());
+  }
+
+  void onImage(const sensor_msgs::ImageConstPtr& image) {
+    cv_bridge::CvImageConstPtr gray;
+    try {
+      // mono8 is shared, not copied; other encodings are converted.
+      gray = cv_bridge::toCvShare(image, "mono8");
+    } catch (const cv_bridge::Exception& e) {
+      NODELET_ERROR_THROTTLE(5.0, "image with encoding '%s' cannot be converted to mono8: %s",
+                             image->encoding.c_str(), e.what());
+      return;
+    }
+    const int64_t t_ns = toNs(image->header.stamp);
+    if (last_t_ns_ != 0 && t_ns + kJumpBackNs < last_t_ns_) {
+      // A bag played again, or a restarted simulation: a new run.
+      NODELET_WARN("time jumped back %.1f s: the front end starts afresh",
+                   (last_t_ns_ - t_ns) * 1e-9);
+      front_end_ = std::make_unique<alvio::FrontEnd>(config_);
+      last_t_ns_ = 0;
+    }
+    if (last_t_ns_ != 0 && t_ns <= last_t_ns_) {
+      NODELET_WARN_THROTTLE(5.0, "image stamps go back in time (%.3f s after %.3f s): skipped",
+                            t_ns * 1e-9, last_t_ns_ * 1e-9);
+      return;
+    }
+    if (last_t_ns_ != 0 && t_ns - last_t_ns_ > 3 * frame_period_ns_ / 2)
+      NODELET_WARN_THROTTLE(5.0, "%.0f ms between images (camera rate %.0f Hz): frames were lost",
+                            (t_ns - last_t_ns_) * 1e-6, 1e9 / frame_period_ns_);
+    last_t_ns_ = t_ns;
+    if (reset_pending_) {
+      front_end_->resetPoints();
+      reset_pending_ = false;
+    }
+
+    alvio::FrameTiming timing;
+    timing.t = t_ns * 1e-9;
+    const alvio::FeatureFrame frame = front_end_->track(gray->image, t_ns, &timing);
+    auto out = boost::make_shared<SharedTrackedFrame>();
+    toMsg(frame, timing, image->header, &out->features);
+    out->image = image;  // the received pointer itself: no copy
+    frame_pub_.publish(out);
+  }
+
+  // After an estimator reset the point tracks start afresh, as in the offline pipeline.
+  void onStatus(const alvio::PipelineStatus::ConstPtr& status) {
+    // Fewer resets than before: the estimator was restarted (reloaded, new run).
+    if (status->reset_count > reset_count_) reset_pending_ = true;
+    reset_count_ = status->reset_count;
+  }
+
+  static constexpr int64_t kJumpBackNs = 1000000000;
+
+  CoreLogRoute log_route_;
+  alvio::Config config_;
+  std::unique_ptr<alvio::FrontEnd> front_end_;
+  std::unique_ptr<image_transport::ImageTransport> transport_;
+  image_transport::Subscriber image_sub_;
+  ros::Subscriber status_sub_;
+  ros::Publisher frame_pub_;
+  int64_t frame_period_ns_ = 50000000, last_t_ns_ = 0;
+  int reset_count_ = 0;
+  bool reset_pending_ = false;
+};
+
+}  // namespace alvio_ros
+
+PLUGINLIB_EXPORT_CLASS(alvio_ros::TrackerNodelet, nodelet::Nodelet)

@@ -1,0 +1,362 @@
+// Integration test of the nodelet pipeline, run by rostest (nodelet_pipeline.test:
+// every nodelet in one manager; nodelet_processes.test: tracker and estimator as
+// separate processes). It waits for the nodelets, starts the paused bag player,
+// records the camera images, odometry, TF and status until the bag has ended, then
+// checks: odometry and TF at the image rate once initialised, with the images'
+// stamps; ATE of the odometry within 1.5x the offline runner's on the same bag;
+// zero-copy (or, across processes, a serialised copy); and, in the manager, that
+// nodelets unload (writing their files) and reload, and that bad parameters leave
+// a nodelet unloaded and the manager running.
+#include <gtest/gtest.h>
+#include <nav_msgs/Odometry.h>
+#include <nodelet/NodeletList.h>
+#include <nodelet/NodeletLoad.h>
+#include <nodelet/NodeletUnload.h>
+#include <ros/ros.h>
+#include <rosgraph_msgs/Log.h>
+#include <sensor_msgs/Image.h>
+#include <std_srvs/SetBool.h>
+#include <tf2_msgs/TFMessage.h>
+
+#include <alvio/PipelineStatus.h>
+#include <alvio/ZeroCopyReport.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <set>
+
+#include "alvio/eval/trajectory_evaluation.h"
+#include "alvio/io/trajectory_io.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Settings {
+  std::string data_dir, output_dir, ns = "/alvio", manager, player = "/player";
+  std::vector<std::string> nodelets;  // expected in the manager (manager mode)
+  bool expect_shared = true, check_ate = true, check_reload = true;
+  double camera_rate_hz = 20;
+};
+
+// Everything the test hears, filled by the spinner's threads.
+struct Recording {
+  std::mutex mutex;
+  std::vector<int64_t> images;
+  std::vector<std::pair<int64_t, alvio::StampedPose>> odometry;
+  std::vector<int64_t> tf;
+  alvio::PipelineStatus status;
+  alvio::ZeroCopyReport report;
+  bool has_report = false;
+  std::vector<rosgraph_msgs::Log> log;
+  ros::WallTime last_image_wall;
+};
+
+Settings g_settings;
+Recording g_rec;
+const fs::file_time_type g_start = fs::file_time_type::clock::now();
+bool g_played = false;
+std::string g_unavailable;
+
+bool waitFor(const std::function<bool()>& done, double timeout_s) {
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(timeout_s);
+  while (ros::ok() && ros::WallTime::now() < end) {
+    if (done()) return true;
+    ros::WallDuration(0.05).sleep();
+  }
+  return done();
+}
+
+bool advertised(const std::string& topic) {
+  ros::master::V_TopicInfo topics;
+  ros::master::getTopics(topics);
+  return std::any_of(topics.begin(), topics.end(),
+                     [&](const ros::master::TopicInfo& t) { return t.name == topic; });
+}
+
+std::vector<std::string> listNodelets() {
+  nodelet::NodeletList list;
+  if (!ros::service::call(g_settings.manager + "/list", list)) return {};
+  return list.response.nodelets;
+}
+
+bool listed(const std::string& name) {
+  const auto names = listNodelets();
+  return std::find(names.begin(), names.end(), name) != names.end();
+}
+
+// Once per run: wait for the nodelets, play the bag, wait for its end.
+void playOnce() {
+  if (g_played) return;
+  g_played = true;
+  const Settings& s = g_settings;
+  const std::string estimator = s.ns + "/estimator/odometry", frame = s.ns + "/tracker/frame";
+  ASSERT_TRUE(waitFor([&] { return advertised(estimator) && advertised(frame); }, 60))
+      << "the tracker and estimator did not come up";
+  for (const auto& name : s.nodelets) {
+    ASSERT_TRUE(waitFor([&] { return listed(name); }, 60)) << name << " was not loaded";
+  }
+  ros::WallDuration(1.0).sleep();  // subscriptions follow the advertisements
+
+  ASSERT_TRUE(ros::service::waitForService(s.player + "/pause_playback", ros::Duration(30)));
+  std_srvs::SetBool resume;
+  resume.request.data = false;
+  ASSERT_TRUE(ros::service::call(s.player + "/pause_playback", resume));
+
+  ASSERT_TRUE(waitFor(
+      [] {
+        std::lock_guard<std::mutex> lock(g_rec.mutex);
+        return !g_rec.images.empty();
+      },
+      30))
+      << "no camera image arrived";
+  // The bag has ended when no image came for 3 s; then let the estimator catch up.
+  waitFor(
+      [] {
+        std::lock_guard<std::mutex> lock(g_rec.mutex);
+        return (ros::WallTime::now() - g_rec.last_image_wall).toSec() > 3.0;
+      },
+      600);
+  waitFor(
+      [] {
+        std::lock_guard<std::mutex> lock(g_rec.mutex);
+        return !g_rec.odometry.empty() && g_rec.odometry.back().first >= g_rec.images.back();
+      },
+      10);
+  ros::WallDuration(0.5).sleep();
+}
+
+alvio::Trajectory recordedTrajectory() {
+  std::lock_guard<std::mutex> lock(g_rec.mutex);
+  alvio::Trajectory t;
+  for (const auto& [stamp, pose] : g_rec.odometry) t.push_back(pose);
+  return t;
+}
+
+#define REQUIRE_DATA()                                 \
+  if (!g_unavailable.empty()) {                        \
+    GTEST_SKIP() << "no test data: " << g_unavailable; \
+  }                                                    \
+  playOnce();                                          \
+  if (HasFatalFailure()) return
+
+}  // namespace
+
+TEST(NodeletPipeline, OdometryAndTfArriveAtTheImageRateWithImageStamps) {
+  REQUIRE_DATA();
+  std::lock_guard<std::mutex> lock(g_rec.mutex);
+  ASSERT_FALSE(g_rec.odometry.empty()) << "no odometry: the estimator never initialised";
+  const int64_t first = g_rec.odometry.front().first, last = g_rec.odometry.back().first;
+  const std::set<int64_t> image_stamps(g_rec.images.begin(), g_rec.images.end());
+  const auto after = static_cast<double>(std::count_if(g_rec.images.begin(), g_rec.images.end(),
+                                                       [&](int64_t t) { return t >= first; }));
+  const auto tf_after = static_cast<double>(
+      std::count_if(g_rec.tf.begin(), g_rec.tf.end(), [&](int64_t t) { return t >= first; }));
+  const double odometry = static_cast<double>(g_rec.odometry.size());
+  std::cout << "images " << g_rec.images.size() << ", after initialisation " << after
+            << ", odometry " << odometry << ", TF " << tf_after << ", initialised "
+            << (first - g_rec.images.front()) * 1e-9
+            << " s after the first image, status: " << g_rec.status.frames << " frames, "
+            << g_rec.status.dropped_frames << " dropped, " << g_rec.status.reset_count
+            << " resets\n";
+  EXPECT_GE(odometry, 0.95 * after) << "odometry must follow every image once initialised";
+  EXPECT_GE(tf_after, 0.95 * after);
+  const double rate = (odometry - 1) / ((last - first) * 1e-9);
+  EXPECT_NEAR(rate, g_settings.camera_rate_hz, 0.1 * g_settings.camera_rate_hz)
+      << "odometry rate in message time";
+  for (const auto& [stamp, pose] : g_rec.odometry)
+    ASSERT_TRUE(image_stamps.count(stamp)) << "odometry stamp " << stamp << " is no image's";
+  EXPECT_EQ(g_rec.status.state, alvio::PipelineStatus::TRACKING);
+}
+
+TEST(NodeletPipeline, AteWithinOneAndAHalfTimesTheOfflineRunners) {
+  if (!g_settings.check_ate) GTEST_SKIP() << "not checked in this configuration";
+  REQUIRE_DATA();
+  const alvio::Trajectory gt = alvio::readTrajectory(g_settings.data_dir + "/groundtruth.tum");
+  const alvio::Trajectory offline =
+      alvio::readTrajectory(g_settings.data_dir + "/offline/trajectory.tum");
+  const alvio::EvaluationOptions options;  // SE(3) alignment, as alvio_run reports
+  const double ate_offline = alvio::evaluateTrajectory(offline, gt, options).ate_translation_m.rmse;
+  const alvio::Trajectory ros = recordedTrajectory();
+  ASSERT_GE(ros.size(), 3u);
+  const double ate_ros = alvio::evaluateTrajectory(ros, gt, options).ate_translation_m.rmse;
+  std::cout << "ATE RMSE: nodelets " << ate_ros << " m (" << ros.size() << " poses), offline "
+            << ate_offline << " m (" << offline.size() << " poses)\n";
+  EXPECT_LE(ate_ros, 1.5 * ate_offline);
+}
+
+TEST(NodeletPipeline, ImagesReachTheSubscribersAsTheCamerasOwnMessages) {
+  REQUIRE_DATA();
+  ASSERT_TRUE(waitFor(
+      [] {
+        std::lock_guard<std::mutex> lock(g_rec.mutex);
+        return g_rec.has_report && g_rec.report.frames > 0;
+      },
+      10));
+  std::lock_guard<std::mutex> lock(g_rec.mutex);
+  const alvio::ZeroCopyReport& r = g_rec.report;
+  std::cout << "zero-copy monitor: " << r.frames << " frames, " << r.shared << " shared, "
+            << r.copied << " copied, " << r.unmatched << " unmatched (" << r.camera_images
+            << " camera images)\n";
+  EXPECT_LE(r.unmatched, 2u);
+  if (g_settings.expect_shared) {
+    EXPECT_EQ(r.copied, 0u) << "inside one manager no image may be copied";
+    EXPECT_GE(r.shared + r.unmatched, r.frames);
+    EXPECT_GT(r.shared, 0u);
+  } else {
+    EXPECT_EQ(r.shared, 0u) << "across processes the image must arrive as a serialised copy";
+    EXPECT_GE(r.copied + r.unmatched, r.frames);
+    EXPECT_GT(r.copied, 0u);
+  }
+}
+
+namespace {
+
+bool unload(const std::string& name) {
+  nodelet::NodeletUnload srv;
+  srv.request.name = name;
+  return ros::service::call(g_settings.manager + "/unload_nodelet", srv) && srv.response.success;
+}
+
+bool load(const std::string& name, const std::string& type) {
+  nodelet::NodeletLoad srv;
+  srv.request.name = name;
+  srv.request.type = type;
+  return ros::service::call(g_settings.manager + "/load_nodelet", srv) && srv.response.success;
+}
+
+// Written (closed) while this test ran, not left over from an earlier run.
+bool writtenNow(const std::string& path) {
+  return fs::is_regular_file(path) && fs::file_size(path) > 0 &&
+         fs::last_write_time(path) > g_start;
+}
+
+// A FATAL message on /rosout (rostest runs no aggregator) about `node`, mentioning `text`.
+bool fatalLogged(const std::string& node, const std::string& text) {
+  std::lock_guard<std::mutex> lock(g_rec.mutex);
+  return std::any_of(g_rec.log.begin(), g_rec.log.end(), [&](const rosgraph_msgs::Log& m) {
+    return m.level == rosgraph_msgs::Log::FATAL && m.msg.find(text) != std::string::npos &&
+           m.msg.find(node) != std::string::npos;
+  });
+}
+
+}  // namespace
+
+TEST(NodeletPipeline, NodeletsUnloadWritingTheirFilesAndReload) {
+  if (!g_settings.check_reload) GTEST_SKIP() << "not checked in this configuration";
+  REQUIRE_DATA();
+  const std::string ns = g_settings.ns, out = g_settings.output_dir;
+  const std::vector<std::pair<std::string, std::string>> nodelets = {
+      {ns + "/mapping", "alvio/MappingNodelet"},
+      {ns + "/logger", "alvio/LoggerNodelet"},
+      {ns + "/estimator", "alvio/EstimatorNodelet"},
+      {ns + "/tracker", "alvio/TrackerNodelet"}};
+  for (const auto& [name, type] : nodelets) ASSERT_TRUE(unload(name)) << name;
+
+  // What each one writes when it goes.
+  const alvio::Trajectory written = alvio::readTrajectory(out + "/trajectory.tum");
+  EXPECT_EQ(written.size(), recordedTrajectory().size()) << "trajectory.tum vs odometry";
+  for (const char* f : {"octomap.bt", "lines.csv", "lines.ply", "map.3Dscene", "alvio.rawlog",
+                        "alvio.3Dscene", "alvio.log"})
+    EXPECT_TRUE(writtenNow(out + "/" + f)) << f << " was not written into " << out;
+
+  for (const auto& [name, type] : nodelets) EXPECT_TRUE(load(name, type)) << name;
+  for (const auto& [name, type] : nodelets) EXPECT_TRUE(listed(name)) << name;
+
+  // Bad parameters: the nodelet stays unloaded, with a message naming the key.
+  ros::NodeHandle nh;
+  nh.setParam(ns + "/bad_estimator/config/estimator/use_lines", std::string("maybe"));
+  EXPECT_FALSE(load(ns + "/bad_estimator", "alvio/EstimatorNodelet"));
+  nh.setParam(ns + "/bad_mapping/publish_period", std::string("often"));
+  EXPECT_FALSE(load(ns + "/bad_mapping", "alvio/MappingNodelet"));
+  nh.setParam(ns + "/bad_tracker/config/points/max_featurez", 100);
+  EXPECT_FALSE(load(ns + "/bad_tracker", "alvio/TrackerNodelet"));
+  EXPECT_TRUE(waitFor([&] { return fatalLogged("bad_estimator", "estimator.use_lines"); }, 5));
+  EXPECT_TRUE(waitFor([&] { return fatalLogged("bad_mapping", "publish_period"); }, 5));
+  EXPECT_TRUE(waitFor([&] { return fatalLogged("bad_tracker", "points/max_featurez"); }, 5));
+
+  // The manager is still there, with exactly the good nodelets.
+  const auto names = listNodelets();
+  EXPECT_FALSE(names.empty()) << "the manager does not answer";
+  for (const auto& [name, type] : nodelets)
+    EXPECT_NE(std::find(names.begin(), names.end(), name), names.end()) << name;
+  for (const char* bad : {"/bad_estimator", "/bad_mapping", "/bad_tracker"})
+    EXPECT_EQ(std::find(names.begin(), names.end(), ns + bad), names.end()) << bad;
+}
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "alvio_pipeline_check");
+  ros::NodeHandle nh, pnh("~");
+  Settings& s = g_settings;
+  pnh.getParam("data_dir", s.data_dir);
+  pnh.getParam("output_dir", s.output_dir);
+  pnh.getParam("ns", s.ns);
+  pnh.getParam("manager", s.manager);
+  pnh.getParam("player", s.player);
+  pnh.getParam("nodelets", s.nodelets);
+  pnh.getParam("expect_shared", s.expect_shared);
+  pnh.getParam("check_ate", s.check_ate);
+  pnh.getParam("check_reload", s.check_reload);
+  std::string image_topic = "/cam0/image_raw";
+  pnh.getParam("image_topic", image_topic);
+  if (fs::exists(s.data_dir + "/UNAVAILABLE")) {
+    std::ifstream in(s.data_dir + "/UNAVAILABLE");
+    std::getline(in, g_unavailable);
+  } else if (!fs::exists(s.data_dir + "/sim.bag")) {
+    g_unavailable = s.data_dir + "/sim.bag is missing";
+  }
+
+  auto onImage = [](const sensor_msgs::ImageConstPtr& m) {
+    std::lock_guard<std::mutex> lock(g_rec.mutex);
+    g_rec.images.push_back(static_cast<int64_t>(m->header.stamp.toNSec()));
+    g_rec.last_image_wall = ros::WallTime::now();
+  };
+  auto onOdometry = [](const nav_msgs::OdometryConstPtr& m) {
+    alvio::StampedPose p;
+    p.t = m->header.stamp.toSec();
+    p.p = {m->pose.pose.position.x, m->pose.pose.position.y, m->pose.pose.position.z};
+    const auto& q = m->pose.pose.orientation;
+    p.q = Eigen::Quaterniond(q.w, q.x, q.y, q.z).normalized();
+    std::lock_guard<std::mutex> lock(g_rec.mutex);
+    g_rec.odometry.emplace_back(static_cast<int64_t>(m->header.stamp.toNSec()), p);
+  };
+  auto onTf = [](const tf2_msgs::TFMessageConstPtr& m) {
+    std::lock_guard<std::mutex> lock(g_rec.mutex);
+    for (const auto& t : m->transforms)
+      if (t.header.frame_id == "world" && t.child_frame_id == "body")
+        g_rec.tf.push_back(static_cast<int64_t>(t.header.stamp.toNSec()));
+  };
+  auto onStatus = [](const alvio::PipelineStatusConstPtr& m) {
+    std::lock_guard<std::mutex> lock(g_rec.mutex);
+    g_rec.status = *m;
+  };
+  auto onReport = [](const alvio::ZeroCopyReportConstPtr& m) {
+    std::lock_guard<std::mutex> lock(g_rec.mutex);
+    g_rec.report = *m;
+    g_rec.has_report = true;
+  };
+  auto onLog = [](const rosgraph_msgs::LogConstPtr& m) {
+    std::lock_guard<std::mutex> lock(g_rec.mutex);
+    g_rec.log.push_back(*m);
+  };
+  const auto hints = ros::TransportHints().tcpNoDelay();
+  std::vector<ros::Subscriber> subs = {
+      nh.subscribe<sensor_msgs::Image>(image_topic, 100, onImage, ros::VoidConstPtr(), hints),
+      nh.subscribe<nav_msgs::Odometry>(s.ns + "/estimator/odometry", 1000, onOdometry,
+                                       ros::VoidConstPtr(), hints),
+      nh.subscribe<tf2_msgs::TFMessage>("/tf", 1000, onTf, ros::VoidConstPtr(), hints),
+      nh.subscribe<alvio::PipelineStatus>(s.ns + "/estimator/status", 100, onStatus,
+                                          ros::VoidConstPtr(), hints),
+      nh.subscribe<alvio::ZeroCopyReport>(s.ns + "/zero_copy_monitor/report", 10, onReport,
+                                          ros::VoidConstPtr(), hints),
+      nh.subscribe<rosgraph_msgs::Log>("/rosout", 1000, onLog, ros::VoidConstPtr(), hints)};
+  ros::AsyncSpinner spinner(2);
+  spinner.start();
+  const int result = RUN_ALL_TESTS();
+  spinner.stop();
+  ros::shutdown();
+  return result;
+}
