@@ -77,8 +77,11 @@ launch_pid=$!
 trap 'kill -INT "$launch_pid" 2>/dev/null || true; kill "$core_pid" 2>/dev/null || true; wait 2>/dev/null || true' EXIT
 # The player appears, plays and leaves; then the estimator gets 1 s without frames to hand
 # the window to the map (flush_after_s) before the pipeline shuts down and writes its files.
-for _ in $(seq 150); do rosnode list 2>/dev/null | grep -q '^/player$' && break; sleep 0.2; done
-while rosnode list 2>/dev/null | grep -q '^/player$'; do
+# (grep reads a captured list: under pipefail, `rosnode list | grep -q` fails at random when
+# grep quits first and rosnode list dies of SIGPIPE.)
+player_up() { local nodes; nodes=$(rosnode list 2>/dev/null || true); grep -q '^/player$' <<<"$nodes"; }
+for _ in $(seq 150); do player_up && break; sleep 0.2; done
+while player_up; do
   kill -0 "$launch_pid" 2>/dev/null || die "roslaunch ended early (see $out/roslaunch.log)"
   sleep 1
 done

@@ -1,14 +1,17 @@
 // alvio_run: the offline runner. Reads an EuRoC folder or a rosbag, runs the
 // whole pipeline on every frame and writes the trajectory and timing, and the map
 // (octomap.bt, lines.ply, lines.csv, map.3Dscene) unless mapping.enabled is false.
+#include <algorithm>
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <sstream>
 
 #include "alvio/common/arg_parser.h"
 #include "alvio/common/error.h"
 #include "alvio/common/logging.h"
 #include "alvio/config/config.h"
+#include "alvio/config/yaml_overlay.h"
 #include "alvio/config/yaml_reader.h"
 #include "alvio/logging/run_logger.h"
 #include "alvio/mapping/map_observer.h"
@@ -31,10 +34,32 @@ int main(int argc, char** argv) {
   args.option("line-tracker", "flow (ALVIO optical flow) | descriptor (PL-VIO LBD baseline)");
   args.flag("quiet", "no progress bar");
   args.option("analysis", "write sensitivity-analysis records (CSV) into this folder");
+  args.option("set",
+              "override configuration keys: key=value[,key=value...] "
+              "(e.g. estimator.selection.points=true)");
   args.flag("no-log", "no MRPT logs (rawlog, 3D scene, alvio.log); also config logger.enabled");
   try {
     if (!args.parse(argc, argv)) return 0;
-    Config config = Config::load(args.get("config"));
+    // The configuration file with the --set overrides laid over it; the reader keeps the
+    // file's path, so relative paths in it still resolve next to the file.
+    const std::string config_path = args.get("config");
+    std::string config_text = readTextFile(config_path);
+    std::vector<std::string> override_keys;
+    if (args.isSet("set")) {
+      std::stringstream list(args.get("set"));
+      for (std::string assignment; std::getline(list, assignment, ',');) {
+        const std::string overlay = assignmentToYaml(assignment);
+        config_text = overlayYaml(config_text, config_path, overlay, "--set " + assignment);
+        const auto keys = yamlLeafKeys(overlay);
+        override_keys.insert(override_keys.end(), keys.begin(), keys.end());
+      }
+    }
+    const YamlReader config_yaml = YamlReader::fromString(config_text, config_path);
+    Config config = Config::load(config_yaml);
+    const MappingOptions mapping = MappingOptions::load(config_yaml, "mapping");
+    for (const std::string& key : config_yaml.unknownKeys())
+      if (std::find(override_keys.begin(), override_keys.end(), key) != override_keys.end())
+        throw Error("--set: unknown configuration key '" + key + "' (misspelt?)");
     if (args.isSet("no-lines")) config.estimator.use_lines = false;
     if (args.isSet("analysis")) config.estimator.record_analysis = true;
     if (args.isSet("line-tracker")) {
@@ -64,7 +89,6 @@ int main(int argc, char** argv) {
       options.observers.push_back(analysis.get());
     }
     std::unique_ptr<MapObserver> map;
-    const MappingOptions mapping = MappingOptions::load(YamlReader(args.get("config")), "mapping");
     if (mapping.enabled) {
       map = std::make_unique<MapObserver>(mapping, config.camera.T_b_c);
       options.observers.push_back(map.get());

@@ -52,3 +52,17 @@ TEST(YamlOverlay, AGroupOverASingleValueIsAnError) {
   EXPECT_THROW(overlayYaml("a: 1\n", "base", "[1, 2]\n", "ROS"), Error);
   EXPECT_THROW(readTextFile("/nonexistent/alvio.yaml"), Error);
 }
+
+TEST(YamlOverlay, AssignmentsBecomeNestedOverlays) {
+  EXPECT_EQ(assignmentToYaml("estimator.selection.points=true"),
+            "estimator:\n  selection:\n    points: true\n");
+  const std::string merged =
+      overlayYaml("estimator:\n  window_size: 10\n  max_iterations: 8\n", "base.yaml",
+                  assignmentToYaml("estimator.window_size=6"), "--set");
+  const YamlReader yaml = YamlReader::fromString(merged, "merged");
+  EXPECT_EQ(yaml.getInt("estimator.window_size"), 6);
+  EXPECT_EQ(yaml.getInt("estimator.max_iterations"), 8);
+  EXPECT_THROW(assignmentToYaml("estimator.window_size"), Error);
+  EXPECT_THROW(assignmentToYaml("=3"), Error);
+  EXPECT_THROW(assignmentToYaml("estimator..window_size=3"), Error);
+}

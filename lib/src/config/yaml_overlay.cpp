@@ -85,4 +85,26 @@ std::string readTextFile(const std::string& path) {
   return buffer.str();
 }
 
+std::string assignmentToYaml(const std::string& assignment) {
+  const auto eq = assignment.find('=');
+  if (eq == std::string::npos || eq == 0)
+    throw Error("configuration override '" + assignment + "' is not key=value");
+  const std::string key = assignment.substr(0, eq);
+  std::string text;
+  std::string indent;
+  std::size_t start = 0;
+  for (;;) {
+    const auto dot = key.find('.', start);
+    const std::string part = key.substr(start, dot == std::string::npos ? dot : dot - start);
+    if (part.empty()) throw Error("configuration override '" + assignment + "': empty key part");
+    text += indent + part + ":";
+    if (dot == std::string::npos) break;
+    text += "\n";
+    indent += "  ";
+    start = dot + 1;
+  }
+  // Quote nothing: the value is parsed as YAML, so "true", "8" and "[1, 2]" keep their types.
+  return text + " " + assignment.substr(eq + 1) + "\n";
+}
+
 }  // namespace alvio

@@ -19,6 +19,10 @@ std::string overlayYaml(const std::string& base, const std::string& base_name,
 /// Dotted paths of the leaves (non-mapping values) of a YAML mapping text.
 std::vector<std::string> yamlLeafKeys(const std::string& text);
 
+/// A YAML mapping text from one dotted assignment, "estimator.window_size=8" ->
+/// "estimator:\n  window_size: 8\n". Throws alvio::Error on a missing '=' or empty key.
+std::string assignmentToYaml(const std::string& assignment);
+
 /// The contents of a text file; throws alvio::Error naming it when it cannot be read.
 std::string readTextFile(const std::string& path);
 

@@ -1,0 +1,286 @@
+#!/usr/bin/env python3
+"""alvio bench / alvio ablation: run the offline runner over the simulator's benchmark set
+and print markdown tables of accuracy, per-stage time, real-time factor and peak memory.
+
+  ./alvio bench [--sequences sim_MH_01,sim_MH_05] [--variants points,lines] [--out DIR]
+  ./alvio bench --compare lines "fast=--set estimator.max_iterations=4"
+  ./alvio ablation --dataset sim_MH_05
+
+A variant is a name from VARIANTS or "name=<alvio run arguments>"; "--bin PATH" among the
+arguments runs another build's alvio_run (to compare builds). Runs are single-threaded and
+deterministic; --jobs runs several at once (times are then measured under load: compare
+variants only within one invocation, where they are interleaved).
+"""
+import argparse
+import csv
+import json
+import os
+import shlex
+import statistics
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+SURFACES = ROOT / "config" / "selection_surfaces.yaml"
+SEL = "estimator.selection."
+
+# Named variants: alvio run arguments.
+VARIANTS = {
+    "points": "--no-lines",
+    "lines": "",
+    "descriptor": "--line-tracker descriptor",
+    "equal-weights": f"--set {SEL}adaptive_weighting=false",
+    "adaptive": f"--set {SEL}adaptive_weighting=true",
+    "sel-none": f"--set {SEL}adaptive_weighting=true",
+    "sel-lines": f"--set {SEL}adaptive_weighting=true,{SEL}lines=true,{SEL}surfaces_file={SURFACES}",
+    "sel-points": f"--set {SEL}adaptive_weighting=true,{SEL}points=true,{SEL}surfaces_file={SURFACES}",
+    "sel-both": f"--set {SEL}adaptive_weighting=true,{SEL}points=true,{SEL}lines=true,"
+    f"{SEL}surfaces_file={SURFACES}",
+}
+ABLATION = [("no selection", "sel-none"), ("line selection", "sel-lines"),
+            ("point selection", "sel-points"), ("both", "sel-both")]
+DEFAULT_SEQUENCES = ["sim_MH_01", "sim_MH_02", "sim_MH_03", "sim_MH_05", "sim_MH_03_realimu",
+                     "sim_MH_05_realimu", "sim_MH_05_lowtex", "sim_MH_05_dim"]
+
+
+def log(msg):
+    print(f"\033[1m[alvio bench]\033[0m {msg}", file=sys.stderr, flush=True)
+
+
+def parse_variant(spec):
+    if "=" in spec and spec.split("=", 1)[0] not in VARIANTS and not spec.startswith("-"):
+        name, args = spec.split("=", 1)
+    elif spec in VARIANTS:
+        name, args = spec, VARIANTS[spec]
+    else:
+        sys.exit(f"alvio bench: unknown variant '{spec}' (known: {', '.join(VARIANTS)}, "
+                 "or name=<alvio run arguments>)")
+    return name, shlex.split(args)
+
+
+class Run:
+    def __init__(self, seq, data, variant, args, out, binary, max_frames):
+        self.seq, self.variant, self.out = seq, variant, out
+        argv = list(args)
+        if "--bin" in argv:
+            i = argv.index("--bin")
+            binary = argv[i + 1]
+            del argv[i:i + 2]
+        self.cmd = [binary, "--dataset", str(data), "--out", str(out), "--quiet", "--no-log"] + argv
+        if max_frames > 0:
+            self.cmd += ["--max-frames", str(max_frames)]
+        self.proc = None
+        self.rss_mb = None
+        self.wall_s = None
+        self.rc = None
+
+    def start(self):
+        self.out.mkdir(parents=True, exist_ok=True)
+        self.log = open(self.out / "run.log", "w")
+        self.t0 = time.monotonic()
+        self.proc = subprocess.Popen(self.cmd, stdout=self.log, stderr=subprocess.STDOUT)
+
+    def reap(self, status, rusage):
+        self.wall_s = time.monotonic() - self.t0
+        self.rc = os.waitstatus_to_exitcode(status)
+        self.rss_mb = rusage.ru_maxrss / 1024.0
+        self.cpu_s = rusage.ru_utime + rusage.ru_stime
+        self.log.close()
+
+    def result(self):
+        r = {"sequence": self.seq, "variant": self.variant, "rc": self.rc,
+             "wall_s": self.wall_s, "cpu_s": self.cpu_s, "peak_rss_mb": self.rss_mb}
+        summary = self.out / "summary.json"
+        if summary.exists():
+            s = json.loads(summary.read_text())
+            r.update(ate=s.get("ate_rmse_m"), resets=s.get("resets"), frames=s.get("frames"),
+                     poses=s.get("poses"), init=s.get("initialization"), timing=s.get("timing_ms"))
+        stats = self.out / "frame_stats.csv"
+        if stats.exists():
+            with open(stats) as f:
+                rows = [row for row in csv.DictReader(f) if float(row["points_used"] or 0) > 0
+                        or float(row["lines_used"] or 0) > 0]
+            if rows:
+                r["points_used"] = statistics.mean(float(x["points_used"]) for x in rows)
+                r["lines_used"] = statistics.mean(float(x["lines_used"]) for x in rows)
+        timing = self.out / "timing.csv"
+        if timing.exists():
+            with open(timing) as f:
+                rows = list(csv.DictReader(f))
+            if rows:
+                r["duration_s"] = float(rows[-1]["t"]) - float(rows[0]["t"])
+                # Optimisation as the paper counts it: solve plus marginalisation, per frame.
+                opt = sorted(float(x["optimization_ms"]) + float(x["marginalization_ms"])
+                             for x in rows)
+                r["opt_total_median"] = percentile(opt, 50)
+                r["opt_total_p95"] = percentile(opt, 95)
+        return r
+
+
+def percentile(values, q):
+    if not values:
+        return float("nan")
+    k = (len(values) - 1) * q / 100.0
+    lo = int(k)
+    hi = min(lo + 1, len(values) - 1)
+    return values[lo] + (values[hi] - values[lo]) * (k - lo)
+
+
+def run_all(runs, jobs):
+    """Start runs in order (interleaved by the caller), at most `jobs` at a time."""
+    pending = list(runs)
+    active = {}
+    done = 0
+    while pending or active:
+        while pending and len(active) < jobs:
+            r = pending.pop(0)
+            r.start()
+            active[r.proc.pid] = r
+        pid, status, rusage = os.wait4(-1, 0)
+        r = active.pop(pid, None)
+        if r is None:
+            continue
+        r.reap(status, rusage)
+        done += 1
+        res = r.result()
+        ate = f"ATE {res['ate']:.4f} m" if res.get("ate") is not None else f"exit {r.rc}"
+        log(f"[{done}/{len(runs)}] {r.seq} {r.variant}: {ate}, {r.wall_s:.0f} s "
+            f"(see {r.out}/run.log)")
+
+
+def fmt(x, spec=".3f"):
+    return "–" if x is None else format(x, spec)
+
+
+def stage(res, name, key="median"):
+    t = res.get("timing") or {}
+    return t.get(name, {}).get(key)
+
+
+def bench_table(results):
+    lines = ["| sequence | variant | ATE (m) | resets | init scale err (%) | init gravity err (°) "
+             "| total ms median / p95 | points front end ms | lines front end ms "
+             "| opt+marg ms median | real-time factor | peak RSS (MB) |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for r in results:
+        init = r.get("init") or {}
+        pts = None if stage(r, "point_tracking") is None else (
+            stage(r, "point_tracking") + stage(r, "point_detection") + stage(r, "preprocess"))
+        lns = None if stage(r, "line_detection") is None else (
+            stage(r, "line_detection") + stage(r, "line_tracking"))
+        rtf = r["duration_s"] / r["wall_s"] if r.get("duration_s") and r.get("wall_s") else None
+        lines.append(
+            f"| {r['sequence']} | {r['variant']} | {fmt(r.get('ate'), '.4f')} | {fmt(r.get('resets'), 'd')} "
+            f"| {fmt(100 * init['scale_error'] if 'scale_error' in init else None, '.1f')} "
+            f"| {fmt(init.get('gravity_error_deg'), '.2f')} "
+            f"| {fmt(stage(r, 'total'), '.1f')} / {fmt(stage(r, 'total', 'p95'), '.1f')} "
+            f"| {fmt(pts, '.1f')} | {fmt(lns, '.1f')} | {fmt(r.get('opt_total_median'), '.1f')} "
+            f"| {fmt(rtf, '.2f')} | {fmt(r.get('peak_rss_mb'), '.0f')} |")
+    return "\n".join(lines)
+
+
+def ratio(a, b):
+    return None if a is None or b is None or a == 0 else b / a
+
+
+def compare_table(results, a, b):
+    lines = [f"| sequence | ATE {a} | ATE {b} | ATE ratio | total median ratio | opt+marg ratio "
+             f"| peak RSS ratio |", "|---|---|---|---|---|---|---|"]
+    by = {(r["sequence"], r["variant"]): r for r in results}
+    for seq in dict.fromkeys(r["sequence"] for r in results):
+        ra, rb = by.get((seq, a), {}), by.get((seq, b), {})
+        lines.append(
+            f"| {seq} | {fmt(ra.get('ate'), '.4f')} | {fmt(rb.get('ate'), '.4f')} "
+            f"| {fmt(ratio(ra.get('ate'), rb.get('ate')), '.3f')} "
+            f"| {fmt(ratio(stage(ra, 'total'), stage(rb, 'total')), '.3f')} "
+            f"| {fmt(ratio(ra.get('opt_total_median'), rb.get('opt_total_median')), '.3f')} "
+            f"| {fmt(ratio(ra.get('peak_rss_mb'), rb.get('peak_rss_mb')), '.3f')} |")
+    return "\n".join(lines)
+
+
+def ablation_table(results, seq):
+    by = {r["variant"]: r for r in results if r["sequence"] == seq}
+    ref = by.get("sel-none", {})
+    lines = [f"**{seq}**", "",
+             "| configuration | points used / frame | lines used / frame | optimisation ms / frame "
+             "(median) | time vs reference | ATE (m) | ATE vs reference |",
+             "|---|---|---|---|---|---|---|"]
+    for label, v in ABLATION:
+        r = by.get(v, {})
+        dt = ratio(ref.get("opt_total_median"), r.get("opt_total_median"))
+        da = ratio(ref.get("ate"), r.get("ate"))
+        lines.append(
+            f"| {label} | {fmt(r.get('points_used'), '.1f')} | {fmt(r.get('lines_used'), '.1f')} "
+            f"| {fmt(r.get('opt_total_median'), '.2f')} "
+            f"| {'reference' if v == 'sel-none' else fmt(None if dt is None else 100 * (dt - 1), '+.1f') + ' %'} "
+            f"| {fmt(r.get('ate'), '.4f')} "
+            f"| {'reference' if v == 'sel-none' else fmt(None if da is None else 100 * (da - 1), '+.1f') + ' %'} |")
+    return "\n".join(lines)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--data", default=os.environ.get("ALVIO_BENCHMARK_DATA", str(ROOT / "out" / "sim_benchmark")),
+                    help="benchmark set folder (alvio sim --benchmark DIR) [%(default)s]")
+    ap.add_argument("--sequences", "--dataset", default=None,
+                    help="comma-separated sequence names or dataset folders")
+    ap.add_argument("--variants", default="points,lines", help="comma-separated variants [%(default)s]")
+    ap.add_argument("--compare", nargs=2, metavar=("A", "B"), help="compare two variants, as ratios B/A")
+    ap.add_argument("--ablation", action="store_true", help="the paper's four selection configurations")
+    ap.add_argument("--out", default=str(ROOT / "out" / "bench"), help="run folders and tables [%(default)s]")
+    ap.add_argument("--jobs", type=int, default=1, help="runs at once [%(default)s]")
+    ap.add_argument("--max-frames", type=int, default=-1, help="stop each run after this many images")
+    ap.add_argument("--bin", default=os.environ.get("ALVIO_RUN", str(ROOT / "build/devel/lib/alvio/alvio_run")))
+    ap.add_argument("--render", action="store_true", help="render missing sequences first (alvio sim --benchmark)")
+    a = ap.parse_args()
+
+    if a.ablation:
+        variants = [v for _, v in ABLATION]
+    elif a.compare:
+        variants = list(a.compare)
+    else:
+        variants = a.variants.split(",")
+    parsed = [parse_variant(v) for v in variants]
+    seqs = (a.sequences.split(",") if a.sequences else
+            (["sim_MH_05"] if a.ablation else DEFAULT_SEQUENCES))
+    data = Path(a.data)
+    if a.render:
+        names = [s for s in seqs if not Path(s).is_dir()]
+        sim = Path(a.bin).with_name("alvio_sim")
+        subprocess.run([str(sim), "--benchmark", str(data), "--only", ",".join(names)], check=True)
+    datasets = []
+    for s in seqs:
+        d = Path(s) if Path(s).is_dir() else data / s
+        if not (d / "mav0").is_dir():
+            sys.exit(f"alvio bench: no sequence {d} (render it: ./alvio sim --benchmark {data} "
+                     f"--only {s}, or pass --render)")
+        datasets.append((d.name, d))
+    if any(v in ("sel-lines", "sel-points", "sel-both") for v in variants) and not SURFACES.exists():
+        sys.exit(f"alvio bench: {SURFACES} is missing (make it with ./alvio analyze)")
+
+    out = Path(a.out)
+    # Interleave variants per sequence so that load drifts hit all of them alike.
+    runs = [Run(name, d, v, args, out / name / v, a.bin, a.max_frames)
+            for name, d in datasets for v, args in parsed]
+    log(f"{len(runs)} runs ({len(datasets)} sequences x {len(parsed)} variants), {a.jobs} at a time, "
+        f"into {out}")
+    run_all(runs, a.jobs)
+    results = [r.result() for r in runs]
+    (out / "results.json").write_text(json.dumps(results, indent=2))
+
+    if a.ablation:
+        text = "\n\n".join(ablation_table(results, name) for name, _ in datasets)
+    else:
+        text = bench_table(results)
+        if a.compare:
+            text += "\n\n" + compare_table(results, parsed[0][0], parsed[1][0])
+    (out / "results.md").write_text(text + "\n")
+    print(text)
+    log(f"tables in {out}/results.md, numbers in {out}/results.json")
+    return 0 if all(r.rc == 0 for r in runs) else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
