@@ -1,0 +1,223 @@
+// alvio_micro_bench: Google Benchmark micro-benchmarks of the hot paths: line detection and
+// tracking and point tracking on a fixed frame pair, IMU preintegration, factor evaluation and
+// one estimator step (window optimisation) on a synthetic scenario. Built by ./alvio build,
+// never run in CI (timings on shared machines are for people, not for assertions).
+//
+//   alvio_micro_bench [--benchmark_filter=Line] [google benchmark flags]
+//
+// The frame pair comes from the demo sequence: $ALVIO_BENCH_DATA, else out/demo/sim
+// (./alvio demo renders it).
+#include <benchmark/benchmark.h>
+
+#include <Eigen/Geometry>
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+#include <opencv2/imgcodecs.hpp>
+
+#include "alvio/camera/camera_model.h"
+#include "alvio/common/error.h"
+#include "alvio/config/config.h"
+#include "alvio/estimator/estimator.h"
+#include "alvio/estimator/factors/imu_factor.h"
+#include "alvio/estimator/factors/point_projection_factor.h"
+#include "alvio/frontend/point_tracker.h"
+#include "alvio/geometry/line_projection_factor.h"
+#include "alvio/imu/imu_preintegration.h"
+#include "alvio/io/euroc_dataset.h"
+#include "alvio/lines/line_detector.h"
+#include "alvio/lines/line_tracker.h"
+#include "synthetic_scenario.h"
+
+namespace fs = std::filesystem;
+using namespace alvio;
+
+namespace {
+
+const Config& config() {
+  static const Config c = Config::load(Config::defaultPath());
+  return c;
+}
+
+// Two consecutive frames of the demo flight (mid-sequence, the camera moving).
+struct FramePair {
+  cv::Mat a, b;
+};
+
+const FramePair& framePair() {
+  static const FramePair pair = [] {
+    const char* env = std::getenv("ALVIO_BENCH_DATA");
+    const fs::path dir = env ? fs::path(env) : fs::path(ALVIO_SOURCE_DIR) / "out/demo/sim";
+    const fs::path images = dir / "mav0/cam0/data";
+    if (!fs::is_directory(images))
+      throw Error("no frames in " + images.string() +
+                  ": run ./alvio demo (or set ALVIO_BENCH_DATA to an EuRoC folder)");
+    std::vector<fs::path> files;
+    for (const auto& e : fs::directory_iterator(images)) files.push_back(e.path());
+    std::sort(files.begin(), files.end());
+    if (files.size() < 2) throw Error(images.string() + " has fewer than two images");
+    const std::size_t k = files.size() / 2;
+    FramePair p{cv::imread(files[k].string(), cv::IMREAD_GRAYSCALE),
+                cv::imread(files[k + 1].string(), cv::IMREAD_GRAYSCALE)};
+    if (p.a.empty() || p.b.empty()) throw Error("cannot read " + files[k].string());
+    return p;
+  }();
+  return pair;
+}
+
+void BM_LineDetection(benchmark::State& state) {
+  const FramePair& f = framePair();
+  LineDetector detector(config().lines.detector, f.a.size());
+  std::size_t n = 0;
+  for (auto _ : state) n = detector.detect(f.a).size();
+  state.counters["lines"] = static_cast<double>(n);
+}
+BENCHMARK(BM_LineDetection)->Unit(benchmark::kMillisecond);
+
+// Detection + undistortion + tracking, alternating between the two frames so that tracks
+// live on (the steady state of the flow tracker: mostly Type 1 lines).
+void trackLines(benchmark::State& state, const std::string& kind) {
+  const FramePair& f = framePair();
+  LineTrackerOptions options = config().lines;
+  options.tracker = kind;
+  auto tracker = createLineTracker(config().camera, options);
+  double t = 0;
+  tracker->track(f.a, t);
+  bool odd = true;
+  double tracked = 0;
+  for (auto _ : state) {
+    t += 0.05;
+    const LineFrame out = tracker->track(odd ? f.b : f.a, t);
+    odd = !odd;
+    tracked = static_cast<double>(out.lines.size());
+  }
+  state.counters["lines"] = tracked;
+}
+void BM_LineTrackingFlow(benchmark::State& state) {
+  trackLines(state, "flow");
+}
+void BM_LineTrackingDescriptor(benchmark::State& state) {
+  trackLines(state, "descriptor");
+}
+BENCHMARK(BM_LineTrackingFlow)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_LineTrackingDescriptor)->Unit(benchmark::kMillisecond);
+
+void BM_PointTracking(benchmark::State& state) {
+  const FramePair& f = framePair();
+  PointTracker tracker(config().points, CameraModel::create(config().camera));
+  int64_t t = 0;
+  tracker.track(f.a, t);
+  bool odd = true;
+  double n = 0;
+  for (auto _ : state) {
+    t += 50000000;
+    n = static_cast<double>(tracker.track(odd ? f.b : f.a, t).points.size());
+    odd = !odd;
+  }
+  state.counters["points"] = n;
+}
+BENCHMARK(BM_PointTracking)->Unit(benchmark::kMillisecond);
+
+// One frame interval of IMU at 200 Hz (10 midpoint steps with covariance propagation).
+void BM_ImuPreintegration(benchmark::State& state) {
+  const Eigen::Vector3d acc(0.3, -0.2, 9.9), gyr(0.1, 0.2, -0.05);
+  for (auto _ : state) {
+    ImuPreintegration pre(acc, gyr, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), ImuNoise());
+    for (int i = 0; i < 10; ++i) pre.push(0.005, acc + 0.01 * i * acc, gyr);
+    benchmark::DoNotOptimize(pre.correctedDeltaP(Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()));
+  }
+}
+BENCHMARK(BM_ImuPreintegration)->Unit(benchmark::kMicrosecond);
+
+// Residuals and all Jacobians of one factor of each kind.
+struct FactorInputs {
+  double pose_i[7] = {0.1, 0.2, 0.3, 0, 0, 0, 1};
+  double pose_j[7] = {0.3, 0.1, 0.35, 0.01, 0.02, 0.0, 0.9997};
+  double speed_bias_i[9] = {0.5, 0, 0, 0, 0, 0, 0, 0, 0};
+  double speed_bias_j[9] = {0.5, 0.02, 0, 0, 0, 0, 0, 0, 0};
+  double inverse_depth = 0.25;
+  double line[4] = {0.1, -0.2, 0.3, 0.4};  // orthonormal (quaternion part normalised below)
+  double residuals[15];
+  double jac[4][15 * 9];
+  FactorInputs() {
+    Eigen::Map<Eigen::Quaterniond> q(pose_j + 3);
+    q.normalize();
+  }
+};
+
+void BM_ImuFactor(benchmark::State& state) {
+  const Eigen::Vector3d acc(0.3, -0.2, 9.9), gyr(0.1, 0.2, -0.05);
+  ImuPreintegration pre(acc, gyr, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), ImuNoise());
+  for (int i = 0; i < 10; ++i) pre.push(0.005, acc, gyr);
+  ImuFactor factor(&pre, Eigen::Vector3d(0, 0, 9.81));
+  FactorInputs in;
+  const double* params[4] = {in.pose_i, in.speed_bias_i, in.pose_j, in.speed_bias_j};
+  double* jacobians[4] = {in.jac[0], in.jac[1], in.jac[2], in.jac[3]};
+  for (auto _ : state) benchmark::DoNotOptimize(factor.Evaluate(params, in.residuals, jacobians));
+}
+BENCHMARK(BM_ImuFactor)->Unit(benchmark::kMicrosecond);
+
+void BM_PointProjectionFactor(benchmark::State& state) {
+  PointProjectionFactor factor(Eigen::Vector2d(0.1, -0.05), Eigen::Vector2d(0.12, -0.04),
+                               config().camera.T_b_c, 300.0);
+  FactorInputs in;
+  const double* params[3] = {in.pose_i, in.pose_j, &in.inverse_depth};
+  double* jacobians[3] = {in.jac[0], in.jac[1], in.jac[2]};
+  for (auto _ : state) benchmark::DoNotOptimize(factor.Evaluate(params, in.residuals, jacobians));
+}
+BENCHMARK(BM_PointProjectionFactor)->Unit(benchmark::kMicrosecond);
+
+void BM_LineProjectionFactor(benchmark::State& state) {
+  LineProjectionFactor factor(Eigen::Vector2d(-0.2, 0.1), Eigen::Vector2d(0.3, 0.12),
+                              config().camera.T_b_c, 300.0);
+  FactorInputs in;
+  // An orthonormal line block: unit quaternion (x, y, z, w) + angle; normalise the quaternion.
+  Eigen::Map<Eigen::Vector4d> l(in.line);
+  l.head<3>() *= 0.5;
+  const double* params[2] = {in.pose_i, in.line};
+  double* jacobians[2] = {in.jac[0], in.jac[1]};
+  for (auto _ : state) benchmark::DoNotOptimize(factor.Evaluate(params, in.residuals, jacobians));
+}
+BENCHMARK(BM_LineProjectionFactor)->Unit(benchmark::kMicrosecond);
+
+// One estimator step in steady state (window full, points and lines): IMU propagation,
+// triangulation, the window optimisation and marginalisation. Each iteration is the next
+// frame of a long synthetic flight, so the work is representative rather than repeated.
+void BM_EstimatorStep(benchmark::State& state) {
+  test::ScenarioOptions so;
+  so.duration_s = 120;
+  static const test::SyntheticScenario scenario(so, config().camera, config().imu);
+  Estimator estimator(config().estimator, config().camera, config().imu);
+  const auto& imu = scenario.imu();
+  const auto& frames = scenario.frames();
+  std::size_t next_imu = 0, next_frame = 0;
+  auto feedFrame = [&] {
+    const FeatureFrame& f = frames[next_frame++];
+    while (next_imu < imu.size() && imu[next_imu].t_ns <= f.t_ns) estimator.addImu(imu[next_imu++]);
+    estimator.addFrame(f);
+  };
+  while (next_frame < 200) feedFrame();  // initialise and fill the window (not timed)
+  for (auto _ : state) {
+    if (next_frame >= frames.size()) {
+      state.SkipWithError("scenario exhausted: lower --benchmark_min_time");
+      break;
+    }
+    feedFrame();
+  }
+}
+BENCHMARK(BM_EstimatorStep)->Unit(benchmark::kMillisecond)->Iterations(400);
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  try {
+    benchmark::RunSpecifiedBenchmarks();
+  } catch (const Error& e) {
+    std::cerr << "alvio_micro_bench: error: " << e.what() << "\n";
+    return 2;
+  }
+  benchmark::Shutdown();
+  return 0;
+}
