@@ -31,6 +31,7 @@ VARIANTS = {
     "points": "--no-lines",
     "lines": "",
     "descriptor": "--line-tracker descriptor",
+    "lines-analysis": "--analysis {out}/analysis",  # records for ./alvio analyze
     "equal-weights": f"--set {SEL}adaptive_weighting=false",
     "adaptive": f"--set {SEL}adaptive_weighting=true",
     "sel-none": f"--set {SEL}adaptive_weighting=true",
@@ -63,7 +64,7 @@ def parse_variant(spec):
 class Run:
     def __init__(self, seq, data, variant, args, out, binary, max_frames):
         self.seq, self.variant, self.out = seq, variant, out
-        argv = list(args)
+        argv = [x.replace("{out}", str(out)) for x in args]  # "{out}": this run's folder
         if "--bin" in argv:
             i = argv.index("--bin")
             binary = argv[i + 1]
@@ -80,7 +81,12 @@ class Run:
         self.out.mkdir(parents=True, exist_ok=True)
         self.log = open(self.out / "run.log", "w")
         self.t0 = time.monotonic()
-        self.proc = subprocess.Popen(self.cmd, stdout=self.log, stderr=subprocess.STDOUT)
+        env = dict(os.environ)
+        libs = Path(self.cmd[0]).resolve().parent.parent / "lib"
+        if (Path(self.cmd[0]).resolve().parent.name == "bin") and libs.is_dir():
+            # A frozen build (scripts/freeze_build.sh): its own libraries, not build/'s.
+            env["LD_LIBRARY_PATH"] = str(libs) + ":" + env.get("LD_LIBRARY_PATH", "")
+        self.proc = subprocess.Popen(self.cmd, stdout=self.log, stderr=subprocess.STDOUT, env=env)
 
     def reap(self, status, rusage):
         self.wall_s = time.monotonic() - self.t0
@@ -233,6 +239,9 @@ def main():
     ap.add_argument("--jobs", type=int, default=1, help="runs at once [%(default)s]")
     ap.add_argument("--max-frames", type=int, default=-1, help="stop each run after this many images")
     ap.add_argument("--bin", default=os.environ.get("ALVIO_RUN", str(ROOT / "build/devel/lib/alvio/alvio_run")))
+    ap.add_argument("--freeze", action="store_true",
+                    help="copy the build's programs and libraries into OUT/bin first, so a rebuild "
+                    "during the runs cannot break them")
     ap.add_argument("--render", action="store_true", help="render missing sequences first (alvio sim --benchmark)")
     a = ap.parse_args()
 
@@ -261,6 +270,11 @@ def main():
         sys.exit(f"alvio bench: {SURFACES} is missing (make it with ./alvio analyze)")
 
     out = Path(a.out)
+    if a.freeze:
+        env = dict(os.environ, ALVIO_BUILD_DIR=str(Path(a.bin).resolve().parent.parent.parent))
+        a.bin = subprocess.run([str(ROOT / "scripts/freeze_build.sh"), str(out / "frozen")], env=env,
+                               check=True, capture_output=True, text=True).stdout.strip()
+        log(f"frozen build: {a.bin}")
     # Interleave variants per sequence so that load drifts hit all of them alike.
     runs = [Run(name, d, v, args, out / name / v, a.bin, a.max_frames)
             for name, d in datasets for v, args in parsed]

@@ -65,14 +65,23 @@ const FramePair& framePair() {
   return pair;
 }
 
-void BM_LineDetection(benchmark::State& state) {
+void detectLines(benchmark::State& state, const std::string& method) {
   const FramePair& f = framePair();
-  LineDetector detector(config().lines.detector, f.a.size());
+  LineDetectorOptions options = config().lines.detector;
+  options.method = method;
+  LineDetector detector(options, f.a.size());
   std::size_t n = 0;
   for (auto _ : state) n = detector.detect(f.a).size();
   state.counters["lines"] = static_cast<double>(n);
 }
-BENCHMARK(BM_LineDetection)->Unit(benchmark::kMillisecond);
+void BM_LineDetectionLsd(benchmark::State& state) {
+  detectLines(state, "lsd");
+}
+void BM_LineDetectionFld(benchmark::State& state) {
+  detectLines(state, "fld");
+}
+BENCHMARK(BM_LineDetectionLsd)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_LineDetectionFld)->Unit(benchmark::kMillisecond);
 
 // Detection + undistortion + tracking, alternating between the two frames so that tracks
 // live on (the steady state of the flow tracker: mostly Type 1 lines).

@@ -11,14 +11,23 @@ LineDetector::LineDetector(const LineDetectorOptions& options, cv::Size image_si
   min_length_ = options_.min_length_ratio * std::hypot(image_size.width, image_size.height);
   // OpenCV's defaults apart from the scale, sigma and refinement (quant 2, angle 22.5 deg,
   // log_eps 0, density 0.7, 1024 bins).
-  lsd_ =
-      cv::createLineSegmentDetector(options_.lsd_refine ? cv::LSD_REFINE_STD : cv::LSD_REFINE_NONE,
-                                    options_.lsd_scale, options_.lsd_sigma_scale);
+  if (options_.method == "fld")
+    // Segments shorter than any we keep are not worth FLD's fitting; no merging (the tracker
+    // merges split lines itself, as Type 3).
+    fld_ = cv::ximgproc::createFastLineDetector(static_cast<int>(shortestLength()), 1.41421356f,
+                                                50.0, 50.0, 3, false);
+  else
+    lsd_ = cv::createLineSegmentDetector(
+        options_.lsd_refine ? cv::LSD_REFINE_STD : cv::LSD_REFINE_NONE, options_.lsd_scale,
+        options_.lsd_sigma_scale);
 }
 
 std::vector<LineSegment> LineDetector::detect(const cv::Mat& gray, const cv::Mat& valid_mask) {
   std::vector<cv::Vec4f> raw;
-  lsd_->detect(gray, raw);
+  if (fld_)
+    fld_->detect(gray, raw);
+  else
+    lsd_->detect(gray, raw);
 
   // The mask is the undistorter's, the same every frame: prepare it once.
   if (valid_mask.data != source_mask_.data) {

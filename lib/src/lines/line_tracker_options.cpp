@@ -28,6 +28,7 @@ void require(bool ok, const std::string& where, const std::string& key, const st
 LineDetectorOptions LineDetectorOptions::load(const YamlReader& yaml, const std::string& prefix) {
   LineDetectorOptions o;
   const std::string p = keyPrefix(prefix);
+  o.method = yaml.getString(p + "method", o.method);
   o.min_length_ratio = yaml.getDouble(p + "min_length_ratio", o.min_length_ratio);
   o.continuation_length_factor =
       yaml.getDouble(p + "continuation_length_factor", o.continuation_length_factor);
@@ -42,6 +43,8 @@ LineDetectorOptions LineDetectorOptions::load(const YamlReader& yaml, const std:
 }
 
 void LineDetectorOptions::validate(const std::string& where) const {
+  if (method != "lsd" && method != "fld")
+    throw Error(where + ": key 'method' must be lsd or fld, got '" + method + "'");
   require(min_length_ratio > 0 && min_length_ratio < 1, where, "min_length_ratio", "in (0, 1)",
           min_length_ratio);
   require(continuation_length_factor > 0 && continuation_length_factor <= 1, where,

@@ -34,7 +34,7 @@ struct EstimatorOptions {
   FeatureSelectionOptions selection;
 
   // Initialisation.
-  double init_min_parallax_px = 80;  ///< rotation-compensated, reference frame to newest
+  double init_min_parallax_px = 40;  ///< rotation-compensated, reference frame to newest
   int init_min_correspondences = 20;
   double init_retry_interval_s = 0.1;
   double init_min_excitation = 0.005;  ///< std of mean acceleration per frame [m/s^2]

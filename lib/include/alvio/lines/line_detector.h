@@ -1,10 +1,11 @@
 #pragma once
-// LSD line segment detection (OpenCV's cv::LineSegmentDetector), with a minimum length and a
-// cap on the count (the longest are kept). The detector is built once and reused for every
-// frame.
+// Line segment detection, LSD (OpenCV's cv::LineSegmentDetector) or FLD (ximgproc), with a minimum
+// length and a cap on the count (the longest are kept). The detector is built once and reused for
+// every frame.
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
+#include <opencv2/ximgproc/fast_line_detector.hpp>
 #include <vector>
 
 #include "alvio/lines/line_segment.h"
@@ -31,6 +32,7 @@ class LineDetector {
   LineDetectorOptions options_;
   double min_length_;
   cv::Ptr<cv::LineSegmentDetector> lsd_;
+  cv::Ptr<cv::ximgproc::FastLineDetector> fld_;
   cv::Mat source_mask_;  // the valid mask last seen (compared by data pointer)
   cv::Mat eroded_mask_;  // it shrunk by the border margin; empty if it is all valid
 };
