@@ -271,7 +271,7 @@ def main():
 
     out = Path(a.out)
     if a.freeze:
-        env = dict(os.environ, ALVIO_BUILD_DIR=str(Path(a.bin).resolve().parent.parent.parent))
+        env = dict(os.environ, ALVIO_BUILD_DIR=str(Path(a.bin).resolve().parents[3]))
         a.bin = subprocess.run([str(ROOT / "scripts/freeze_build.sh"), str(out / "frozen")], env=env,
                                check=True, capture_output=True, text=True).stdout.strip()
         log(f"frozen build: {a.bin}")
