@@ -90,6 +90,7 @@ int main(int argc, char** argv) {
            {{"distance_m", options.line_distance_tol_m},
             {"angle_deg", options.line_angle_tol_deg}}},
           {"precision", m.line_map.precision},
+          {"on_surface_length_fraction", m.line_on_surface_fraction},
           {"recall", m.line_map.recall},
           {"map_length_m", m.line_map.map_length_m},
           {"true_edges", m.line_map.true_edges},
@@ -117,7 +118,8 @@ int main(int argc, char** argv) {
               << "line map (" << options.line_distance_tol_m << " m, " << options.line_angle_tol_deg
               << " deg): precision " << 100 * m.line_map.precision << " %  recall "
               << 100 * m.line_map.recall << " % of " << m.line_map.true_length_m
-              << " m of true edges\n"
+              << " m of true edges; " << 100 * m.line_on_surface_fraction
+              << " % of the map line length lies on a true surface\n"
               << "octomap: " << m.occupancy.occupied_voxels << " occupied voxels, "
               << 100 * m.occupancy.fraction << " % within " << options.voxel_tolerance_m
               << " m of a surface (mean distance " << m.occupancy.mean_distance_m << " m)\n"

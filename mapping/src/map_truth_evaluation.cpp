@@ -67,6 +67,15 @@ MapTruthEvaluation evaluateMapAgainstTruth(const std::vector<Segment3>& lines_es
   out.line_errors = summariseLineErrors(lines, true_edges);
   out.line_map = evaluateLineMap(lines, true_edges, options.line_distance_tol_m,
                                  options.line_angle_tol_deg * M_PI / 180.0);
+  double total = 0, on_surface = 0;
+  for (const Segment3& l : lines) {
+    total += l.length();
+    const bool on = surface_distance(l.p0) <= options.line_distance_tol_m &&
+                    surface_distance(l.p1) <= options.line_distance_tol_m &&
+                    surface_distance(0.5 * (l.p0 + l.p1)) <= options.line_distance_tol_m;
+    if (on) on_surface += l.length();
+  }
+  out.line_on_surface_fraction = total > 0 ? on_surface / total : 0;
   if (tree)
     out.occupancy = evaluateOccupancy(
         *tree, [&](const Eigen::Vector3d& c) { return surface_distance(T_gt_est.apply(c)); },

@@ -65,6 +65,7 @@ TEST(MapTruth, MapInAnotherFrameIsScoredAfterTheAlignment) {
   EXPECT_NEAR(m.line_errors.median_midpoint_distance_m, 0.0, 1e-6);
   EXPECT_NEAR(m.line_map.precision, 24.0 / 24.6, 0.01);
   EXPECT_NEAR(m.line_map.recall, 1.0, 0.01);
+  EXPECT_NEAR(m.line_on_surface_fraction, 24.0 / 24.6, 1e-9);  // the inner line is 0.4 m off
   const double near = static_cast<double>(m.occupancy.within_tolerance);
   EXPECT_GT(m.occupancy.occupied_voxels, 40u);
   EXPECT_NEAR(m.occupancy.fraction, near / m.occupancy.occupied_voxels, 1e-12);

@@ -44,6 +44,9 @@ struct MapTruthOptions {
 
 struct MapTruthEvaluation {
   LineErrorSummary line_errors;
+  /// Length fraction of map lines lying on a true surface (both endpoints and the midpoint
+  /// within the line distance tolerance of one): texture lines are there, not on edges.
+  double line_on_surface_fraction = 0;
   LineMapEvaluation line_map;
   OccupancyEvaluation occupancy;
 };
