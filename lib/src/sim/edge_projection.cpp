@@ -2,6 +2,7 @@
 
 #include <cstdio>
 
+#include "alvio/io/text_table_reader.h"
 #include "alvio/io/trajectory_io.h"
 
 namespace alvio::sim {
@@ -58,6 +59,24 @@ void writeSceneEdgesCsv(const std::string& path, const Scene& scene) {
     text += scene.objectNames()[e.object] + "\n";
   }
   writeFileAtomically(path, text);
+}
+
+std::vector<SceneEdge> readSceneEdgesCsv(const std::string& path) {
+  TextTableReader reader(path);
+  std::vector<SceneEdge> edges;
+  std::vector<std::string> f;
+  while (reader.next(&f)) {
+    if (f.size() < 7) reader.fail("expected id,ax,ay,az,bx,by,bz,object");
+    SceneEdge e;
+    e.id = static_cast<int>(reader.toInt64(f[0], 1));
+    for (int i = 0; i < 3; ++i) {
+      e.a[i] = reader.toDouble(f[1 + i], 2 + i);
+      e.b[i] = reader.toDouble(f[4 + i], 5 + i);
+    }
+    e.object = -1;
+    edges.push_back(e);
+  }
+  return edges;
 }
 
 }  // namespace alvio::sim

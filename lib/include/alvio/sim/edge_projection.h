@@ -35,5 +35,8 @@ std::vector<VisibleEdge> projectVisibleEdges(const Scene& scene, const CameraMod
 
 /// Write the scene's 3D edges as CSV: id, ax, ay, az, bx, by, bz, object name.
 void writeSceneEdgesCsv(const std::string& path, const Scene& scene);
+/// Read such a CSV back (the object index is -1: the file only names the object). Throws
+/// alvio::Error naming the file and line of a malformed row.
+std::vector<SceneEdge> readSceneEdgesCsv(const std::string& path);
 
 }  // namespace alvio::sim

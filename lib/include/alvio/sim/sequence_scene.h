@@ -1,0 +1,23 @@
+#pragma once
+// The scene a rendered sequence was made from, for evaluations against its ground truth.
+// sim_info.yaml names the scene file (`# scene: machine_hall.yaml <hash>` in its header);
+// the scene is loaded from config/scenes/ and checked against the sequence's own
+// scene_edges.csv, so that an edited scene file cannot silently score against a different
+// world than the one rendered.
+
+#include <string>
+
+#include "alvio/sim/scene_file.h"
+
+namespace alvio::sim {
+
+/// The scene file named in `sim_info_path`; throws alvio::Error when it names none.
+std::string sceneNameFromSimInfo(const std::string& sim_info_path);
+
+/// Load the scene of the sequence in `sequence_dir` (or `scene_override`, a name or path, when
+/// not empty) and check that its edges are those of `sequence_dir`/scene_edges.csv (same IDs,
+/// endpoints within 1e-5 m). Throws alvio::Error on any mismatch.
+SceneFile loadSequenceScene(const std::string& sequence_dir,
+                            const std::string& scene_override = "");
+
+}  // namespace alvio::sim

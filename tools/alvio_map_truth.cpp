@@ -1,0 +1,136 @@
+// alvio_map_truth: a map written by `alvio run` against the simulator's true scene. The
+// estimated trajectory (trajectory.tum) is aligned to groundtruth.tum (SE(3), Umeyama); that
+// alignment brings the map lines (lines.csv) and the occupied OctoMap voxels (octomap.bt) into
+// the true world, where they are compared with the scene's edges and surfaces: line angle and
+// midpoint distance to the nearest true edge, line map precision / recall, fraction of voxels
+// near a surface, and the map's size.
+#include <octomap/OcTree.h>
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "alvio/common/arg_parser.h"
+#include "alvio/common/error.h"
+#include "alvio/eval/trajectory_evaluation.h"
+#include "alvio/io/trajectory_io.h"
+#include "alvio/mapping/map_files.h"
+#include "alvio/mapping/map_truth_evaluation.h"
+#include "alvio/mapping/occupancy_map.h"
+#include "alvio/sim/edge_projection.h"
+#include "alvio/sim/sequence_scene.h"
+#include "alvio/sim/surface_distance.h"
+
+using namespace alvio;
+namespace fs = std::filesystem;
+
+namespace {
+std::uintmax_t sizeOf(const fs::path& p) {
+  return fs::exists(p) ? fs::file_size(p) : 0;
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  ArgParser args("alvio_map_truth",
+                 "A run's map (lines.csv, octomap.bt) against the simulator's true scene.\n"
+                 "Usage: alvio_map_truth [options] RUN_DIR SEQUENCE_DIR");
+  args.option("scene", "scene file or name (default: the one sim_info.yaml names)", "");
+  args.option("line-distance", "line map tolerance: distance to a true edge (m)", "0.10");
+  args.option("line-angle", "line map tolerance: angle to a true edge (deg)", "3");
+  args.option("voxel-tolerance", "voxel centre to a true surface (m); default 2 voxels", "");
+  args.option("json", "write every figure to this JSON file");
+  try {
+    if (!args.parse(argc, argv)) return 0;
+    if (args.positional().size() != 2) throw Error("give RUN_DIR and SEQUENCE_DIR");
+    const fs::path run = args.positional()[0], seq = args.positional()[1];
+
+    // Alignment estimate -> truth from the trajectories.
+    const Trajectory est = readTrajectory((run / "trajectory.tum").string());
+    const Trajectory gt = readTrajectory((seq / "groundtruth.tum").string());
+    EvaluationOptions eo;
+    eo.alignment = AlignmentMode::kSE3;
+    const EvaluationResult traj = evaluateTrajectory(est, gt, eo);
+
+    const sim::SceneFile scene = sim::loadSequenceScene(seq.string(), args.get("scene"));
+    std::vector<Segment3> edges;
+    for (const sim::SceneEdge& e : scene.scene.edges()) edges.push_back({e.a, e.b});
+    const sim::SurfaceDistance surfaces(scene.scene);
+
+    const std::vector<MapLine> map_lines = readLinesCsv((run / kLinesCsvFileName).string());
+    std::vector<Segment3> lines;
+    for (const MapLine& l : map_lines) lines.push_back(l.segment());
+    const std::unique_ptr<octomap::OcTree> tree =
+        readOctomapBinary((run / kOctomapFileName).string());
+
+    MapTruthOptions options;
+    options.line_distance_tol_m = args.getDouble("line-distance");
+    options.line_angle_tol_deg = args.getDouble("line-angle");
+    options.voxel_tolerance_m = args.isSet("voxel-tolerance") ? args.getDouble("voxel-tolerance")
+                                                              : 2 * tree->getResolution();
+    const MapTruthEvaluation m = evaluateMapAgainstTruth(
+        lines, tree.get(), traj.alignment, edges,
+        [&](const Eigen::Vector3d& p) { return surfaces(p); }, options);
+    const VoxelCounts voxels = countVoxels(*tree);
+
+    const nlohmann::json report = {
+        {"run", run.string()},
+        {"sequence", seq.string()},
+        {"alignment",
+         {{"mode", "se3"},
+          {"matched_poses", traj.matched},
+          {"ate_rmse_m", traj.ate_translation_m.rmse},
+          {"ate_median_m", traj.ate_translation_m.median}}},
+        {"lines",
+         {{"count", m.line_errors.lines},
+          {"median_angle_deg", m.line_errors.median_angle_deg},
+          {"p90_angle_deg", m.line_errors.p90_angle_deg},
+          {"median_midpoint_distance_m", m.line_errors.median_midpoint_distance_m},
+          {"p90_midpoint_distance_m", m.line_errors.p90_midpoint_distance_m},
+          {"tolerance",
+           {{"distance_m", options.line_distance_tol_m},
+            {"angle_deg", options.line_angle_tol_deg}}},
+          {"precision", m.line_map.precision},
+          {"on_surface_length_fraction", m.line_on_surface_fraction},
+          {"recall", m.line_map.recall},
+          {"map_length_m", m.line_map.map_length_m},
+          {"true_edges", m.line_map.true_edges},
+          {"true_length_m", m.line_map.true_length_m}}},
+        {"octomap",
+         {{"resolution_m", tree->getResolution()},
+          {"occupied_voxels", m.occupancy.occupied_voxels},
+          {"free_voxels", voxels.free},
+          {"tolerance_m", options.voxel_tolerance_m},
+          {"fraction_near_surface", m.occupancy.fraction},
+          {"mean_surface_distance_m", m.occupancy.mean_distance_m}}},
+        {"memory",
+         {{"octree_bytes", tree->memoryUsage()},
+          {"line_count", map_lines.size()},
+          {"octomap_bt_bytes", sizeOf(run / kOctomapFileName)},
+          {"lines_csv_bytes", sizeOf(run / kLinesCsvFileName)},
+          {"lines_ply_bytes", sizeOf(run / kLinesPlyFileName)}}}};
+
+    std::cout << std::fixed << std::setprecision(3) << "alignment: SE(3) over " << traj.matched
+              << " poses, ATE RMSE " << traj.ate_translation_m.rmse << " m\n"
+              << "lines: " << m.line_errors.lines << "  angle to nearest true edge median "
+              << m.line_errors.median_angle_deg << " deg (p90 " << m.line_errors.p90_angle_deg
+              << ")  midpoint distance median " << m.line_errors.median_midpoint_distance_m
+              << " m (p90 " << m.line_errors.p90_midpoint_distance_m << ")\n"
+              << "line map (" << options.line_distance_tol_m << " m, " << options.line_angle_tol_deg
+              << " deg): precision " << 100 * m.line_map.precision << " %  recall "
+              << 100 * m.line_map.recall << " % of " << m.line_map.true_length_m
+              << " m of true edges; " << 100 * m.line_on_surface_fraction
+              << " % of the map line length lies on a true surface\n"
+              << "octomap: " << m.occupancy.occupied_voxels << " occupied voxels, "
+              << 100 * m.occupancy.fraction << " % within " << options.voxel_tolerance_m
+              << " m of a surface (mean distance " << m.occupancy.mean_distance_m << " m)\n"
+              << "memory: octree " << tree->memoryUsage() << " B, " << map_lines.size()
+              << " lines; files octomap.bt " << sizeOf(run / kOctomapFileName) << " B, lines.csv "
+              << sizeOf(run / kLinesCsvFileName) << " B, lines.ply "
+              << sizeOf(run / kLinesPlyFileName) << " B\n";
+    if (args.isSet("json")) writeFileAtomically(args.get("json"), report.dump(2) + "\n");
+    return 0;
+  } catch (const Error& e) {
+    std::cerr << "alvio_map_truth: error: " << e.what() << "\n";
+    return 2;
+  }
+}
