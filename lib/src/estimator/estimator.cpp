@@ -62,6 +62,7 @@ void Estimator::clearState() {
   marginalization_ = Marginalization::kOld;
   frame_count_ = 0;
   last_init_attempt_ = -1e9;
+  first_moving_attempt_ = -1;
   last_wait_reason_.clear();
   bias_prior_pending_ = false;
 }

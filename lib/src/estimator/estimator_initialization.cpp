@@ -69,7 +69,15 @@ bool Estimator::initialStructure(double t) {
   Eigen::Vector3d t_ref_last;
   // Parallax is measured after removing the rotation the gyroscope saw: rotation alone
   // gives parallax but no baseline, and the essential matrix of such a pair is unreliable.
-  const double min_parallax = options_.init_min_parallax_px / camera_.intrinsics[0];
+  // The relaxed threshold applies once the window has shown that much parallax for
+  // init_relax_after_s without reaching the strict one (the clock starts at that sighting).
+  const double relaxed_parallax =
+      std::min(options_.init_relaxed_parallax_px, options_.init_min_parallax_px) /
+      camera_.intrinsics[0];
+  const bool relaxed =
+      first_moving_attempt_ >= 0 && t - first_moving_attempt_ >= options_.init_relax_after_s;
+  const double min_parallax =
+      relaxed ? relaxed_parallax : options_.init_min_parallax_px / camera_.intrinsics[0];
   const Eigen::Matrix3d R_b_c = T_b_c_.linear();
   for (int i = 0; i < W_; ++i) {
     const auto corr = points_.correspondences(i, W_);
@@ -83,6 +91,7 @@ bool Estimator::initialStructure(double t) {
       parallax += (a.head<2>() - b_in_i.head<2>() / b_in_i.z()).norm();
     }
     parallax /= corr.size();
+    if (parallax >= relaxed_parallax && first_moving_attempt_ < 0) first_moving_attempt_ = t;
     if (parallax < min_parallax) continue;
     if (relativePoseFromEssential(corr, &R_ref_last, &t_ref_last)) {
       ref = i;

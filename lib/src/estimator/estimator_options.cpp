@@ -26,6 +26,9 @@ EstimatorOptions EstimatorOptions::load(const YamlReader& yaml, const std::strin
   o.line_triangulation = LineTriangulationOptions::load(yaml, p + "line_triangulation");
   o.selection = FeatureSelectionOptions::load(yaml, p + "selection");
   o.init_min_parallax_px = yaml.getDouble(p + "init_min_parallax_px", o.init_min_parallax_px);
+  o.init_relaxed_parallax_px =
+      yaml.getDouble(p + "init_relaxed_parallax_px", o.init_relaxed_parallax_px);
+  o.init_relax_after_s = yaml.getDouble(p + "init_relax_after_s", o.init_relax_after_s);
   o.init_min_correspondences =
       yaml.getInt(p + "init_min_correspondences", o.init_min_correspondences);
   o.init_retry_interval_s = yaml.getDouble(p + "init_retry_interval_s", o.init_retry_interval_s);

@@ -213,6 +213,7 @@ class Estimator {
   int64_t last_queued_imu_ns_ = 0;
 
   double last_init_attempt_ = -1e9;
+  double first_moving_attempt_ = -1;  ///< when the relaxed parallax was first seen
   std::string last_wait_reason_;
   Eigen::Matrix3d last_R_ = Eigen::Matrix3d::Identity(), back_R0_ = Eigen::Matrix3d::Identity();
   Eigen::Vector3d last_P_ = Eigen::Vector3d::Zero(), back_P0_ = Eigen::Vector3d::Zero();

@@ -34,7 +34,12 @@ struct EstimatorOptions {
   FeatureSelectionOptions selection;
 
   // Initialisation.
-  double init_min_parallax_px = 40;  ///< rotation-compensated, reference frame to newest
+  /// Rotation-compensated parallax, reference frame to newest, needed to initialise. A
+  /// wide baseline gives a good scale; after `init_relax_after_s` of motion without one
+  /// (hand-held wiggles, hovering), `init_relaxed_parallax_px` is enough.
+  double init_min_parallax_px = 40;
+  double init_relaxed_parallax_px = 40;
+  double init_relax_after_s = 1.5;
   int init_min_correspondences = 20;
   double init_retry_interval_s = 0.1;
   double init_min_excitation = 0.005;  ///< std of mean acceleration per frame [m/s^2]
