@@ -47,7 +47,9 @@ RosbagSource::RosbagSource(const std::string& path, const TopicOptions& topics)
     : impl_(std::make_unique<Impl>()), path_(path) {
   try {
     open(topics);
-  } catch (const rosbag::BagException& e) {
+  } catch (const Error&) {
+    throw;
+  } catch (const std::exception& e) {
     throw Error("cannot read rosbag '" + path + "' (corrupted or truncated?): " + e.what());
   }
 }
@@ -93,8 +95,11 @@ std::size_t RosbagSource::badMessages() const {
 bool RosbagSource::next(SensorMessage* m) {
   try {
     return nextMessage(m);
-  } catch (const rosbag::BagException& e) {
-    // A damaged chunk or index: the bag cannot be read on from here.
+  } catch (const Error&) {
+    throw;
+  } catch (const std::exception& e) {
+    // A damaged chunk or record header (rosbag, or a bad_alloc from a garbage length):
+    // the bag cannot be read on from here.
     throw Error("rosbag '" + path_ + "' is corrupted or truncated: " + e.what());
   }
 }

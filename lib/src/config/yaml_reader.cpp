@@ -187,6 +187,9 @@ Eigen::Isometry3d YamlReader::getTransform(const std::string& key) const {
   for (int r = 0; r < 4; ++r)
     for (int c = 0; c < 4; ++c) m(r, c) = data[4 * r + c];
   const Eigen::Matrix3d R = m.topLeftCorner<3, 3>();
+  if (std::abs(R.determinant()) < 1e-6)
+    throw Error(where(key) + " is not invertible: its rotation block is singular (det = " +
+                std::to_string(R.determinant()) + ")");
   const double orth_err = (R.transpose() * R - Eigen::Matrix3d::Identity()).norm();
   if (orth_err > 1e-3 || R.determinant() < 0.5) {
     std::ostringstream os;
