@@ -4,8 +4,8 @@
 #
 #   scripts/fuzz.sh [--seconds N] [target...]     default: 120 s each, every target
 #
-# Needs the normal build (./alvio build; fuzz_config links the rest of libalvio_core from
-# it). The growing corpus is kept in build-fuzz/corpus/<target>/, crash inputs in
+# Needs the normal build (./alvio build, run when missing): fuzz_config links the rest of
+# libalvio_core from it. The growing corpus is kept in build-fuzz/corpus/<target>/, crash inputs in
 # build-fuzz/artifacts/<target>/. Exit status 1 when a target crashed.
 set -euo pipefail
 
@@ -35,7 +35,10 @@ if ! command -v clang++ >/dev/null; then
   as_root apt-get install -y -qq --no-install-recommends clang </dev/null
 fi
 
-[[ -f $BUILD/devel/lib/libalvio_core.so ]] || ALVIO_BUILD_DIR="$BUILD" ALVIO_JOBS="$JOBS" "$ROOT/alvio" build
+# fuzz_config links the normal build's libalvio_core, fuzz_feature_msg its message headers.
+if [[ ! -f $BUILD/devel/lib/libalvio_core.so || ! -d $BUILD/devel/include/alvio ]]; then
+  ALVIO_BUILD_DIR="$BUILD" ALVIO_JOBS="$JOBS" "$ROOT/alvio" build
+fi
 if [[ ! -f $FUZZ_BUILD/CMakeCache.txt ]]; then
   log "configuring into $FUZZ_BUILD"
   cmake -S "$ROOT/test/fuzz" -B "$FUZZ_BUILD" -DCMAKE_CXX_COMPILER=clang++ \

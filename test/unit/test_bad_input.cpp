@@ -182,6 +182,21 @@ TEST(BadDataset, CsvWithBadLineNamesFileAndLine) {
   EXPECT_MENTIONS(msg, "not-a-stamp");
 }
 
+// Rounding a fractional stamp at the int64 limit overflowed (UBSan in fuzz_euroc_csv).
+TEST(BadDataset, StampAtTheInt64LimitIsAnErrorNotAnOverflow) {
+  const std::string dir = test::scratchDir();
+  const std::string csv = writeFile(dir + "/cam.csv", "9223372036854775807.9,a.png\n");
+  const std::string msg = errorOf([&] { readEurocImageCsv(csv, dir); });
+  EXPECT_MENTIONS(msg, csv + ":1");
+  EXPECT_MENTIONS(msg, "not an integer");
+  // Fractional stamps round half away from zero, also below zero.
+  writeFile(csv, "-0.7,a.png\n1.5,b.png\n");
+  const auto records = readEurocImageCsv(csv, dir);
+  ASSERT_EQ(records.size(), 2u);
+  EXPECT_EQ(records[0].t_ns, -1);
+  EXPECT_EQ(records[1].t_ns, 2);
+}
+
 TEST(BadDataset, TruncatedPngIsSkippedAndCounted) {
   const std::string dir = test::scratchDir();
   const std::string data = makeEurocFolder(dir + "/data", 5, 752, 480);
