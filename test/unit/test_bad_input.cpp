@@ -197,6 +197,16 @@ TEST(BadDataset, StampAtTheInt64LimitIsAnErrorNotAnOverflow) {
   EXPECT_EQ(records[1].t_ns, 2);
 }
 
+// Found by fuzz_tum_trajectory: a stamp beyond the int64 ns range wrapped and an
+// out-of-order file was accepted by the strict reader.
+TEST(BadDataset, TumStampBeyondNanosecondRangeIsAnError) {
+  const std::string tum = writeFile(test::scratchDir() + "/traj.txt",
+                                    "14037152575.3 0 0 0 0 0 0 1\n1403715274.3 0 0 0 0 0 0 1\n");
+  const std::string msg = errorOf([&] { readTrajectory(tum, TrajectoryFormat::kTum); });
+  EXPECT_MENTIONS(msg, tum + ":1");
+  EXPECT_MENTIONS(msg, "14037152575.3");
+}
+
 TEST(BadDataset, TruncatedPngIsSkippedAndCounted) {
   const std::string dir = test::scratchDir();
   const std::string data = makeEurocFolder(dir + "/data", 5, 752, 480);
