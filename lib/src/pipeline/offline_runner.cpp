@@ -184,7 +184,10 @@ RunResult runOffline(SensorSource& source, const Config& config, const RunOption
   result.interrupted = stopRequested();
   if (!result.interrupted)
     for (const auto& p : pending) processImage(p);
-  progress.finish();
+  progress.finish(result.interrupted
+                      ? "(stopped early after " +
+                            std::to_string(result.frames + result.skipped_images) + ")"
+                      : "");
   if (result.interrupted) logWarn("run stopped early: writing the results so far");
   result.resets = pipeline.estimator().resetCount();
   result.poses = result.trajectory.size();
