@@ -49,7 +49,7 @@ pid_t startRun(const std::vector<std::string>& args, const std::string& log_pref
 
 // Wait until `ready()` or the process ends or `timeout` passes; true when ready.
 template <typename F>
-bool waitUntil(pid_t pid, F&& ready, double timeout_s, bool* exited) {
+bool waitUntil(pid_t pid, F&& ready, double timeout_s, bool* exited, int poll_us = 2000) {
   const auto end = Clock::now() + std::chrono::duration<double>(timeout_s);
   while (Clock::now() < end) {
     if (ready()) return true;
@@ -58,7 +58,7 @@ bool waitUntil(pid_t pid, F&& ready, double timeout_s, bool* exited) {
       *exited = true;
       return false;
     }
-    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    std::this_thread::sleep_for(std::chrono::microseconds(poll_us));
   }
   return false;
 }
@@ -210,9 +210,10 @@ TEST(NothingLost, SigkillDuringSaveKeepsPreviousFile) {
   }
 }
 
-// End to end: a second run into the folder of a first one is SIGKILLed as soon as it
-// starts replacing a map or scene file (or, failing that, at its end). The first run's
-// rawlog is untouched (the second one's is still .part) and every map file loads.
+// End to end: later runs into the folder of a first one are SIGKILLed as soon as they
+// start replacing a map or scene file. The previous rawlog is untouched (the killed run's
+// is still .part) and every map file loads. The saves take milliseconds: a run that ends
+// before one is caught is checked all the same, and run again (up to 5 times).
 TEST(NothingLost, SigkillDuringRunSaveKeepsPreviousMaps) {
   const std::string data = microDataset();
   if (data.empty()) GTEST_SKIP() << "shared EuRoC data not found (../shared/data): skipping";
@@ -220,31 +221,35 @@ TEST(NothingLost, SigkillDuringRunSaveKeepsPreviousMaps) {
   const std::string out = dir + "/out";
   const pid_t first = startRun({"--dataset", data, "--out", out, "--max-frames", "15"}, dir + "/1");
   ASSERT_EQ(waitExitCode(first), 3) << readFile(dir + "/1.err");  // 3: no poses (static)
-  const std::string rawlog_before = readFile(out + "/alvio.rawlog");
-  ASSERT_FALSE(rawlog_before.empty());
-
-  const pid_t second =
-      startRun({"--dataset", data, "--out", out, "--max-frames", "30"}, dir + "/2");
-  bool exited = false;
   const auto saving = [&] {
     for (const char* f : {"octomap.bt", "lines.csv", "lines.ply", "map.3Dscene", "alvio.3Dscene"})
       if (fs::exists(out + "/" + f + ".tmp")) return true;
     return false;
   };
-  const bool mid_save = waitUntil(second, saving, 300, &exited);
-  if (!exited) {
-    kill(second, SIGKILL);
-    waitExitCode(second);
+  bool killed_mid_save = false;
+  for (int attempt = 0; attempt < 5 && !killed_mid_save; ++attempt) {
+    SCOPED_TRACE(attempt);
+    const std::string rawlog_before = readFile(out + "/alvio.rawlog");
+    ASSERT_FALSE(rawlog_before.empty());
+    const pid_t run = startRun({"--dataset", data, "--out", out, "--max-frames", "30"}, dir + "/2");
+    bool exited = false;
+    killed_mid_save = waitUntil(run, saving, 300, &exited, 100);
+    if (!exited) {
+      kill(run, SIGKILL);
+      waitExitCode(run);
+    }
+    if (killed_mid_save) {
+      EXPECT_EQ(readFile(out + "/alvio.rawlog"), rawlog_before);
+      EXPECT_TRUE(fs::exists(out + "/alvio.rawlog.part"));
+    }
+    EXPECT_NO_THROW(readOctomapBinary(out + "/octomap.bt"));
+    EXPECT_NO_THROW(readLinesCsv(out + "/lines.csv"));
+    for (const char* scene : {"map.3Dscene", "alvio.3Dscene"}) {
+      mrpt::opengl::COpenGLScene s;
+      EXPECT_TRUE(s.loadFromFile(out + "/" + scene)) << scene;
+    }
+    mrpt::obs::CRawlog rawlog;
+    EXPECT_TRUE(rawlog.loadFromRawLogFile(out + "/alvio.rawlog"));
   }
-  ASSERT_TRUE(mid_save) << "the run ended before a save was seen: " << readFile(dir + "/2.err");
-  EXPECT_EQ(readFile(out + "/alvio.rawlog"), rawlog_before);
-  EXPECT_TRUE(fs::exists(out + "/alvio.rawlog.part"));
-  EXPECT_NO_THROW(readOctomapBinary(out + "/octomap.bt"));
-  EXPECT_NO_THROW(readLinesCsv(out + "/lines.csv"));
-  for (const char* scene : {"map.3Dscene", "alvio.3Dscene"}) {
-    mrpt::opengl::COpenGLScene s;
-    EXPECT_TRUE(s.loadFromFile(out + "/" + scene)) << scene;
-  }
-  mrpt::obs::CRawlog rawlog;
-  EXPECT_TRUE(rawlog.loadFromRawLogFile(out + "/alvio.rawlog"));
+  EXPECT_TRUE(killed_mid_save) << "no run was caught during a save";
 }
