@@ -153,7 +153,7 @@ TEST(NothingLost, SigkillDuringSaveKeepsPreviousFile) {
       {"octomap.bt",
        [](const std::string& path, int version) {
          octomap::OcTree tree(0.01);
-         const int n = version == 0 ? 10 : 80;
+         const int n = version == 0 ? 10 : 110;
          for (int x = 0; x < n; ++x)
            for (int y = 0; y < n; ++y)
              for (int z = 0; z < n; ++z) tree.updateNode(x * 0.02, y * 0.02, z * 0.02, true);
@@ -192,8 +192,9 @@ TEST(NothingLost, SigkillDuringSaveKeepsPreviousFile) {
         std::_Exit(0);
       }
       bool exited = false;
+      // The octomap's write itself takes about a millisecond: poll fast.
       waitUntil(
-          pid, [&] { return fs::exists(path + ".tmp"); }, 120, &exited);
+          pid, [&] { return fs::exists(path + ".tmp"); }, 120, &exited, 50);
       if (!exited) {
         kill(pid, SIGKILL);
         waitExitCode(pid);
@@ -210,10 +211,10 @@ TEST(NothingLost, SigkillDuringSaveKeepsPreviousFile) {
   }
 }
 
-// End to end: later runs into the folder of a first one are SIGKILLed as soon as they
-// start replacing a map or scene file. The previous rawlog is untouched (the killed run's
-// is still .part) and every map file loads. The saves take milliseconds: a run that ends
-// before one is caught is checked all the same, and run again (up to 5 times).
+// End to end: later runs into the folder of a first one are SIGKILLed mid-run, and as
+// soon as they start replacing a map or scene file. The previous rawlog is untouched
+// while the new one is still .part, and every map file loads. The saves take milliseconds: a run
+// that ends before one is caught is checked all the same, and run again (up to 5 times).
 TEST(NothingLost, SigkillDuringRunSaveKeepsPreviousMaps) {
   const std::string data = microDataset();
   if (data.empty()) GTEST_SKIP() << "shared EuRoC data not found (../shared/data): skipping";
@@ -226,6 +227,21 @@ TEST(NothingLost, SigkillDuringRunSaveKeepsPreviousMaps) {
       if (fs::exists(out + "/" + f + ".tmp")) return true;
     return false;
   };
+  // Killed mid-run: the rawlog being streamed is the .part, the first run's is intact.
+  {
+    const std::string rawlog_before = readFile(out + "/alvio.rawlog");
+    const pid_t run = startRun({"--dataset", data, "--out", out}, dir + "/mid");
+    bool exited = false;
+    ASSERT_TRUE(waitUntil(
+        run, [&] { return readFile(dir + "/mid.err").find(" 30% ") != std::string::npos; }, 300,
+        &exited));
+    kill(run, SIGKILL);
+    EXPECT_EQ(waitExitCode(run), 1000 + SIGKILL);
+    EXPECT_TRUE(fs::exists(out + "/alvio.rawlog.part"));
+    EXPECT_EQ(readFile(out + "/alvio.rawlog"), rawlog_before);
+    mrpt::obs::CRawlog rawlog;
+    EXPECT_TRUE(rawlog.loadFromRawLogFile(out + "/alvio.rawlog"));
+  }
   bool killed_mid_save = false;
   for (int attempt = 0; attempt < 5 && !killed_mid_save; ++attempt) {
     SCOPED_TRACE(attempt);
@@ -238,10 +254,10 @@ TEST(NothingLost, SigkillDuringRunSaveKeepsPreviousMaps) {
       kill(run, SIGKILL);
       waitExitCode(run);
     }
-    if (killed_mid_save) {
+    // The logger finishes (renaming its rawlog) before the map is saved: either rawlog
+    // is complete, and a leftover part means the old one is untouched.
+    if (fs::exists(out + "/alvio.rawlog.part"))
       EXPECT_EQ(readFile(out + "/alvio.rawlog"), rawlog_before);
-      EXPECT_TRUE(fs::exists(out + "/alvio.rawlog.part"));
-    }
     EXPECT_NO_THROW(readOctomapBinary(out + "/octomap.bt"));
     EXPECT_NO_THROW(readLinesCsv(out + "/lines.csv"));
     for (const char* scene : {"map.3Dscene", "alvio.3Dscene"}) {
