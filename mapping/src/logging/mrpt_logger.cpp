@@ -547,8 +547,8 @@ void MrptLogger::finish(const MapSnapshot* final_map) {
     d.rawlog_stream.close();
     std::error_code ec;
     fs::rename(d.paths.rawlog + kPartialSuffix, d.paths.rawlog, ec);
-    if (ec) throw Error("logger: cannot rename " + d.paths.rawlog + kPartialSuffix + ": " +
-                        ec.message());
+    if (ec)
+      throw Error("logger: cannot rename " + d.paths.rawlog + kPartialSuffix + ": " + ec.message());
   }
   if (d.options.text_log) {
     std::ostringstream os;

@@ -37,7 +37,7 @@ using SceneSegments = std::vector<SceneSegment>;
 struct MapSnapshot {
   Trajectory keyframes;                 ///< T_w_b of the window frames, oldest first
   std::vector<Eigen::Vector3d> points;  ///< triangulated window landmarks
-  SceneSegments lines;                   ///< 3D line landmarks
+  SceneSegments lines;                  ///< 3D line landmarks
 };
 
 /// Per-frame numbers for the periodic throughput line of the text log.
