@@ -70,6 +70,13 @@ class TrackerNodelet : public nodelet::Nodelet {
                              image->encoding.c_str(), e.what());
       return;
     }
+    // The tracker would throw out of the callback and take the manager down with it.
+    if (gray->image.cols != config_.camera.width || gray->image.rows != config_.camera.height) {
+      NODELET_ERROR_THROTTLE(5.0, "image is %dx%d but camera.resolution is [%d, %d]: skipped",
+                             gray->image.cols, gray->image.rows, config_.camera.width,
+                             config_.camera.height);
+      return;
+    }
     const int64_t t_ns = toNs(image->header.stamp);
     if (last_t_ns_ != 0 && t_ns + kJumpBackNs < last_t_ns_) {
       // A bag played again, or a restarted simulation: a new run.

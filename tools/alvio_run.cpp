@@ -1,6 +1,7 @@
 // alvio_run: the offline runner. Reads an EuRoC folder or a rosbag, runs the
 // whole pipeline on every frame and writes the trajectory and timing, and the map
 // (octomap.bt, lines.ply, lines.csv, map.3Dscene) unless mapping.enabled is false.
+// SIGINT/SIGTERM stop the run early; everything processed so far is still written.
 #include <algorithm>
 #include <filesystem>
 #include <iostream>
@@ -10,6 +11,7 @@
 #include "alvio/common/arg_parser.h"
 #include "alvio/common/error.h"
 #include "alvio/common/logging.h"
+#include "alvio/common/stop_signal.h"
 #include "alvio/config/config.h"
 #include "alvio/config/yaml_overlay.h"
 #include "alvio/config/yaml_reader.h"
@@ -78,6 +80,7 @@ int main(int argc, char** argv) {
     options.out_dir = args.get("out");
     options.max_frames = args.getInt("max-frames");
     options.progress = !args.isSet("quiet");
+    options.stop = &installStopSignalHandlers();
     std::unique_ptr<RunLogger> logger;
     if (config.logger.enabled && !args.isSet("no-log")) {
       logger = std::make_unique<RunLogger>(config.logger);
@@ -114,8 +117,17 @@ int main(int argc, char** argv) {
       std::cout << " (logger " << r.observer_ms << " ms)\n";
     }
     if (r.evaluation) std::cout << "ATE_RMSE=" << r.evaluation->ate_translation_m.rmse << "\n";
+    if (r.interrupted) {
+      std::cout << "interrupted by signal " << stopSignalNumber() << ": outputs are complete up to "
+                << "the last frame processed\n";
+      return 128 + stopSignalNumber();  // the shell's convention for death by signal
+    }
     return r.poses > 0 ? 0 : 3;
   } catch (const Error& e) {
+    std::cerr << "alvio run: error: " << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    // Third-party failures (rosbag, OpenCV, MRPT) still end with a message, not an abort.
     std::cerr << "alvio run: error: " << e.what() << "\n";
     return 2;
   }

@@ -6,13 +6,34 @@
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/Imu.h>
 
+#include <map>
 #include <opencv2/imgproc.hpp>
-#include <set>
+#include <utility>
 
 #include "alvio/common/error.h"
 #include "alvio/common/logging.h"
 
 namespace alvio {
+
+namespace {
+
+// A message that does not deserialize is skipped and counted.
+template <typename T>
+boost::shared_ptr<T> instantiateOrSkip(const rosbag::MessageInstance& msg, const std::string& path,
+                                       std::size_t* bad) {
+  try {
+    return msg.instantiate<T>();
+  } catch (const rosbag::BagException&) {
+    throw;
+  } catch (const std::exception& e) {
+    if (++*bad <= 5)
+      logWarn("rosbag '", path, "': message on '", msg.getTopic(), "' at ", msg.getTime(),
+              " cannot be read (", e.what(), "): skipped");
+    return nullptr;
+  }
+}
+
+}  // namespace
 
 struct RosbagSource::Impl {
   rosbag::Bag bag;
@@ -25,35 +46,69 @@ struct RosbagSource::Impl {
 RosbagSource::RosbagSource(const std::string& path, const TopicOptions& topics)
     : impl_(std::make_unique<Impl>()), path_(path) {
   try {
-    impl_->bag.open(path, rosbag::bagmode::Read);
-  } catch (const rosbag::BagException& e) {
-    throw Error("cannot open rosbag '" + path + "': " + e.what());
+    open(topics);
+  } catch (const Error&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw Error("cannot read rosbag '" + path + "' (corrupted or truncated?): " + e.what());
   }
+}
+
+void RosbagSource::open(const TopicOptions& topics) {
+  const std::string& path = path_;
+  impl_->bag.open(path, rosbag::bagmode::Read);
   impl_->image_topic = topics.image;
   impl_->imu_topic = topics.imu;
   rosbag::View all(impl_->bag);
-  std::set<std::string> present;
-  for (const auto* c : all.getConnections()) present.insert(c->topic);
-  for (const auto& t : {topics.image, topics.imu})
-    if (!present.count(t)) {
+  std::map<std::string, std::string> present;  // topic -> message type
+  for (const auto* c : all.getConnections()) present[c->topic] = c->datatype;
+  const std::pair<std::string, std::string> expected[] = {{topics.image, "sensor_msgs/Image"},
+                                                          {topics.imu, "sensor_msgs/Imu"}};
+  for (const auto& [topic, type] : expected) {
+    const auto it = present.find(topic);
+    if (it == present.end()) {
       std::string list;
-      for (const auto& p : present) list += (list.empty() ? "" : ", ") + p;
-      throw Error("rosbag '" + path + "' has no topic '" + t + "' (topics: " + list +
+      for (const auto& p : present) list += (list.empty() ? "" : ", ") + p.first;
+      throw Error("rosbag '" + path + "' has no topic '" + topic + "' (topics: " + list +
                   "); set topics.image / topics.imu in the config");
     }
+    // Otherwise every message would fail to instantiate and the run would see no data.
+    if (it->second != type)
+      throw Error("rosbag '" + path + "': topic '" + topic + "' carries " + it->second +
+                  ", expected " + type);
+  }
   image_count_ = rosbag::View(impl_->bag, rosbag::TopicQuery(topics.image)).size();
   impl_->view = std::make_unique<rosbag::View>(
       impl_->bag, rosbag::TopicQuery(std::vector<std::string>{topics.image, topics.imu}));
   impl_->it = impl_->view->begin();
 }
 
-RosbagSource::~RosbagSource() = default;
+RosbagSource::~RosbagSource() {
+  if (impl_->bad_messages > 0)
+    logWarn("rosbag '", path_, "': ", impl_->bad_messages, " unreadable message(s) skipped");
+}
+
+std::size_t RosbagSource::badMessages() const {
+  return impl_->bad_messages;
+}
 
 bool RosbagSource::next(SensorMessage* m) {
+  try {
+    return nextMessage(m);
+  } catch (const Error&) {
+    throw;
+  } catch (const std::exception& e) {
+    // A damaged chunk or record header (rosbag, or a bad_alloc from a garbage length):
+    // the bag cannot be read on from here.
+    throw Error("rosbag '" + path_ + "' is corrupted or truncated: " + e.what());
+  }
+}
+
+bool RosbagSource::nextMessage(SensorMessage* m) {
   for (; impl_->it != impl_->view->end(); ++impl_->it) {
     const rosbag::MessageInstance& msg = *impl_->it;
     if (msg.getTopic() == impl_->imu_topic) {
-      const auto imu = msg.instantiate<sensor_msgs::Imu>();
+      const auto imu = instantiateOrSkip<sensor_msgs::Imu>(msg, path_, &impl_->bad_messages);
       if (!imu) continue;
       m->kind = SensorMessage::Kind::kImu;
       m->imu.t_ns = static_cast<int64_t>(imu->header.stamp.toNSec());
@@ -64,7 +119,7 @@ bool RosbagSource::next(SensorMessage* m) {
       ++impl_->it;
       return true;
     }
-    const auto image = msg.instantiate<sensor_msgs::Image>();
+    const auto image = instantiateOrSkip<sensor_msgs::Image>(msg, path_, &impl_->bad_messages);
     if (!image) continue;
     m->kind = SensorMessage::Kind::kImage;
     m->t_ns = static_cast<int64_t>(image->header.stamp.toNSec());

@@ -16,11 +16,16 @@ class RosbagSource : public SensorSource {
   /// bag lacks them.
   RosbagSource(const std::string& path, const TopicOptions& topics);
   ~RosbagSource() override;
+  /// Throws alvio::Error naming the file when the bag turns out corrupted or truncated;
+  /// single messages that do not deserialize are skipped and counted.
   bool next(SensorMessage* message) override;
+  std::size_t badMessages() const;
   std::size_t imageCount() const override { return image_count_; }
   std::string description() const override { return "rosbag " + path_; }
 
  private:
+  void open(const TopicOptions& topics);
+  bool nextMessage(SensorMessage* message);
   struct Impl;
   std::unique_ptr<Impl> impl_;
   std::string path_;

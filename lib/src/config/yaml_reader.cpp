@@ -137,7 +137,7 @@ std::vector<double> YamlReader::getDoubles(const std::string& key, int expected_
   if (!node.IsSequence()) throw Error(where(key) + " must be a list of numbers");
   std::vector<double> values;
   for (std::size_t i = 0; i < node.size(); ++i)
-    values.push_back(convertDouble(node[i], where(key) + "[" + std::to_string(i) + "]"));
+    values.push_back(convertDouble(node[i], where(key + "[" + std::to_string(i) + "]")));
   if (expected_size >= 0 && static_cast<int>(values.size()) != expected_size)
     throw Error(where(key) + " must have " + std::to_string(expected_size) + " values, got " +
                 std::to_string(values.size()));
@@ -178,7 +178,9 @@ Eigen::Isometry3d YamlReader::getTransform(const std::string& key) const {
     for (std::size_t r = 0; r < 4; ++r) {
       if (!node[r].IsSequence() || node[r].size() != 4)
         throw Error(where(key) + " must be a 4x4 nested list");
-      for (std::size_t c = 0; c < 4; ++c) data.push_back(convertDouble(node[r][c], where(key)));
+      for (std::size_t c = 0; c < 4; ++c)
+        data.push_back(convertDouble(
+            node[r][c], where(key + "[" + std::to_string(r) + "][" + std::to_string(c) + "]")));
     }
   } else {
     data = getDoubles(key, 16);
@@ -187,6 +189,9 @@ Eigen::Isometry3d YamlReader::getTransform(const std::string& key) const {
   for (int r = 0; r < 4; ++r)
     for (int c = 0; c < 4; ++c) m(r, c) = data[4 * r + c];
   const Eigen::Matrix3d R = m.topLeftCorner<3, 3>();
+  if (std::abs(R.determinant()) < 1e-6)
+    throw Error(where(key) + " is not invertible: its rotation block is singular (det = " +
+                std::to_string(R.determinant()) + ")");
   const double orth_err = (R.transpose() * R - Eigen::Matrix3d::Identity()).norm();
   if (orth_err > 1e-3 || R.determinant() < 0.5) {
     std::ostringstream os;

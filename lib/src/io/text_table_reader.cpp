@@ -1,6 +1,7 @@
 #include "alvio/io/text_table_reader.h"
 
 #include <cerrno>
+#include <climits>
 #include <cmath>
 #include <cstdlib>
 #include <sstream>
@@ -73,7 +74,13 @@ int64_t TextTableReader::toInt64(const std::string& field, int column) const {
   if (dot != std::string::npos) {
     const std::string frac = field.substr(dot + 1);
     if (frac.find_first_not_of("0123456789") != std::string::npos) bad();
-    if (!frac.empty() && frac[0] >= '5') v += (v < 0 ? -1 : 1);
+    // Round half away from zero; "-0.7" is negative although its whole part is 0.
+    if (!frac.empty() && frac[0] >= '5') {
+      const bool negative = whole[0] == '-';
+      // Rounding the extreme values would overflow: undefined behaviour (UBSan, fuzz_euroc_csv).
+      if (v == (negative ? LLONG_MIN : LLONG_MAX)) bad();
+      v += negative ? -1 : 1;
+    }
   }
   return v;
 }

@@ -71,6 +71,10 @@ Trajectory readTrajectory(const std::string& path, TrajectoryFormat format,
     double q[4];
     if (tum) {
       pose.t = reader.toDouble(f[0], 0);
+      // Stamps are compared as int64 ns: beyond that range (year 2262) they would wrap
+      // and pass the time-order check out of order (found by fuzz_tum_trajectory).
+      if (!(std::abs(pose.t) < 9.2e9))
+        reader.fail("column 1: time " + f[0] + " s is out of range (|t| < 9.2e9 s)");
       for (int i = 0; i < 3; ++i) pose.p[i] = reader.toDouble(f[1 + i], 1 + i);
       for (int i = 0; i < 4; ++i) q[i] = reader.toDouble(f[4 + i], 4 + i);  // x y z w
       pose.q = Eigen::Quaterniond(q[3], q[0], q[1], q[2]);

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "alvio/common/error.h"
 #include "alvio/common/logging.h"
 #include "alvio/common/progress_bar.h"
 #include "alvio/eval/evaluation_report.h"
@@ -117,6 +118,19 @@ RunResult runOffline(SensorSource& source, const Config& config, const RunOption
       logWarn("image at ", m.t_ns, " ns could not be read: skipped");
       return;
     }
+    if (image.cols != config.camera.width || image.rows != config.camera.height) {
+      const std::string size = std::to_string(image.cols) + "x" + std::to_string(image.rows);
+      const std::string key = config.source + ": key 'camera.resolution' is [" +
+                              std::to_string(config.camera.width) + ", " +
+                              std::to_string(config.camera.height) + "]";
+      // The first image decides: a mismatch there is a wrong config, not a bad frame.
+      if (result.frames == 0)
+        throw Error(key + " but the dataset's images are " + size + " (image at " +
+                    std::to_string(m.t_ns) + " ns)");
+      ++result.skipped_images;
+      logWarn("image at ", m.t_ns, " ns is ", size, " (", key, "): skipped");
+      return;
+    }
     PipelineOutput out = pipeline.addImage(image, m.t_ns);
     ++result.frames;
     result.timing.add(out.timing);
@@ -148,13 +162,14 @@ RunResult runOffline(SensorSource& source, const Config& config, const RunOption
                     out.has_pose ? "tracking" : "initialising");
   };
 
+  const auto stopRequested = [&] { return options.stop && options.stop->load(); };
   SensorMessage m;
   std::size_t images_seen = 0;
-  while (source.next(&m)) {
+  while (!stopRequested() && source.next(&m)) {
     if (m.kind == SensorMessage::Kind::kImu) {
       pipeline.addImu(m.imu);
       notify([&](RunObserver& o) { o.onImu(m.imu); });
-      while (!pending.empty() && pending.front().t_ns < m.t_ns) {
+      while (!pending.empty() && pending.front().t_ns < m.t_ns && !stopRequested()) {
         processImage(pending.front());
         pending.pop_front();
       }
@@ -165,8 +180,15 @@ RunResult runOffline(SensorSource& source, const Config& config, const RunOption
     ++images_seen;
     pending.push_back(m);
   }
-  for (const auto& p : pending) processImage(p);
-  progress.finish();
+  // Images still waiting for IMU are dropped on a stop: stopping promptly matters more.
+  result.interrupted = stopRequested();
+  if (!result.interrupted)
+    for (const auto& p : pending) processImage(p);
+  progress.finish(result.interrupted
+                      ? "(stopped early after " +
+                            std::to_string(result.frames + result.skipped_images) + ")"
+                      : "");
+  if (result.interrupted) logWarn("run stopped early: writing the results so far");
   result.resets = pipeline.estimator().resetCount();
   result.poses = result.trajectory.size();
 
@@ -182,6 +204,7 @@ RunResult runOffline(SensorSource& source, const Config& config, const RunOption
   summary["poses"] = result.poses;
   summary["skipped_images"] = result.skipped_images;
   summary["resets"] = result.resets;
+  summary["interrupted"] = result.interrupted;
   for (const auto& s : result.timing.summary())
     summary["timing_ms"][s.stage] = {
         {"median", s.median_ms}, {"p95", s.p95_ms}, {"max", s.max_ms}, {"mean", s.mean_ms}};

@@ -52,6 +52,8 @@ mrpt::Clock::time_point mrptTime(int64_t t_ns) {
 }
 
 constexpr int64_t kNsPerS = 1'000'000'000;
+// The rawlog being written; renamed to its name when complete.
+constexpr const char* kPartialSuffix = ".part";
 
 std::string nineDigits(int64_t v) {
   std::string s = std::to_string(v);
@@ -348,9 +350,11 @@ MrptLogger::MrptLogger(const LoggerOptions& options, const CameraOptions& camera
   }
   if (options.log_imu || options.log_images || options.log_poses || options.log_ground_truth) {
     d.paths.rawlog = base + ".rawlog";
+    // Streamed into a side file and renamed by finish(): a killed run leaves the previous
+    // rawlog intact (a cut gzip stream would not load) and its own data in .part.
     std::string why;
-    if (!d.rawlog_stream.open(d.paths.rawlog, 1, why))
-      throw Error("logger: cannot open " + d.paths.rawlog + ": " + why);
+    if (!d.rawlog_stream.open(d.paths.rawlog + kPartialSuffix, 1, why))
+      throw Error("logger: cannot open " + d.paths.rawlog + kPartialSuffix + ": " + why);
     d.rawlog = mrpt::serialization::archiveUniquePtrFrom(d.rawlog_stream);
     if (options.log_images) {
       // MRPT's convention: images of X.rawlog live in X_Images/, referenced by file name.
@@ -541,6 +545,10 @@ void MrptLogger::finish(const MapSnapshot* final_map) {
     d.flushUpTo(std::numeric_limits<int64_t>::max());
     d.rawlog.reset();
     d.rawlog_stream.close();
+    std::error_code ec;
+    fs::rename(d.paths.rawlog + kPartialSuffix, d.paths.rawlog, ec);
+    if (ec)
+      throw Error("logger: cannot rename " + d.paths.rawlog + kPartialSuffix + ": " + ec.message());
   }
   if (d.options.text_log) {
     std::ostringstream os;

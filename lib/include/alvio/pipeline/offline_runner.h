@@ -6,8 +6,10 @@
 //   events.log       initialisation, waiting reasons, failures and resets
 //   frame_stats.csv  per frame: features tracked/used, residuals, adaptive weights
 //   summary.json     counts, timing summary, initialisation quality and ATE
+// The files are written when the run ends, also when it is stopped early (RunOptions::stop).
 // and, when the dataset has ground truth, prints the ATE.
 
+#include <atomic>
 #include <functional>
 #include <optional>
 #include <string>
@@ -30,6 +32,9 @@ struct RunOptions {
   int max_frames = -1;  ///< stop after this many images (-1: all)
   /// Called with the run's data (not owned; e.g. the MRPT logger). See run_observer.h.
   std::vector<RunObserver*> observers;
+  /// When set (e.g. by SIGINT), the run stops after the current frame and still writes
+  /// every output file and finishes the observers (maps, logs).
+  const std::atomic<bool>* stop = nullptr;
 };
 
 struct InitializationQuality {
@@ -42,6 +47,7 @@ struct InitializationQuality {
 struct RunResult {
   std::size_t frames = 0, poses = 0, skipped_images = 0;
   int resets = 0;
+  bool interrupted = false;  ///< stopped early by RunOptions::stop
   Trajectory trajectory;
   TimingLog timing;
   std::optional<InitializationQuality> initialization;

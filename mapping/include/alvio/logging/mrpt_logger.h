@@ -7,7 +7,9 @@
 //
 // Data may arrive slightly out of time order (frames are logged when the
 // pipeline is done with them, after later IMU samples): the rawlog is written
-// in time order through a short reorder buffer.
+// in time order through a short reorder buffer. It is streamed into X.rawlog.part and
+// renamed to X.rawlog by finish(), and scenes are replaced by rename, so a run that is
+// killed never leaves a half-written file under the final names.
 //
 // Threads: log() may be called from any thread; everything else from one thread
 // at a time (the offline runner's, or a nodelet's serialised callbacks).
@@ -35,7 +37,7 @@ using SceneSegments = std::vector<SceneSegment>;
 struct MapSnapshot {
   Trajectory keyframes;                 ///< T_w_b of the window frames, oldest first
   std::vector<Eigen::Vector3d> points;  ///< triangulated window landmarks
-  SceneSegments lines;                   ///< 3D line landmarks
+  SceneSegments lines;                  ///< 3D line landmarks
 };
 
 /// Per-frame numbers for the periodic throughput line of the text log.
