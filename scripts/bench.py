@@ -16,6 +16,7 @@ import csv
 import json
 import os
 import shlex
+import shutil
 import statistics
 import subprocess
 import sys
@@ -274,7 +275,17 @@ def main():
         env = dict(os.environ, ALVIO_BUILD_DIR=str(Path(a.bin).resolve().parents[3]))
         a.bin = subprocess.run([str(ROOT / "scripts/freeze_build.sh"), str(out / "frozen")], env=env,
                                check=True, capture_output=True, text=True).stdout.strip()
-        log(f"frozen build: {a.bin}")
+        # The configuration too: a run reads it when it starts, and an edit during a long
+        # benchmark would otherwise split the runs between two settings.
+        frozen_config = out / "frozen" / "config"
+        if frozen_config.exists():
+            shutil.rmtree(frozen_config)
+        shutil.copytree(ROOT / "config", frozen_config)
+        parsed = [(name, [x.replace(str(ROOT / "config"), str(frozen_config)) for x in args])
+                  for name, args in parsed]
+        parsed = [(name, args if "--config" in args else
+                   args + ["--config", str(frozen_config / "euroc.yaml")]) for name, args in parsed]
+        log(f"frozen build: {a.bin}, configuration: {frozen_config}")
     # Interleave variants per sequence so that load drifts hit all of them alike.
     runs = [Run(name, d, v, args, out / name / v, a.bin, a.max_frames)
             for name, d in datasets for v, args in parsed]
