@@ -32,12 +32,13 @@
 #include "alvio/pipeline/frame_imu_sync.h"
 #include "conversions.h"
 #include "core_log_route.h"
+#include "guarded_nodelet.h"
 #include "nodelet_config.h"
 #include "shared_tracked_frame.h"
 
 namespace alvio_ros {
 
-class EstimatorNodelet : public nodelet::Nodelet {
+class EstimatorNodelet : public GuardedNodelet {
  public:
   ~EstimatorNodelet() override {
     {
@@ -53,16 +54,7 @@ class EstimatorNodelet : public nodelet::Nodelet {
   using Sync = alvio::FrameImuSynchronizer<SharedTrackedFrame::ConstPtr>;
   using Clock = std::chrono::steady_clock;
 
-  void onInit() override {
-    try {
-      init();
-    } catch (const std::exception& e) {
-      NODELET_FATAL("%s not loaded: %s", getName().c_str(), e.what());
-      throw;
-    }
-  }
-
-  void init() {
+  void init() override {
     ros::NodeHandle& nh = getNodeHandle();
     ros::NodeHandle& pnh = getPrivateNodeHandle();
     const NodeletConfig config(nh, pnh);

@@ -22,12 +22,13 @@
 #include "alvio/logging/mrpt_logger.h"
 #include "conversions.h"
 #include "core_log_route.h"
+#include "guarded_nodelet.h"
 #include "nodelet_config.h"
 #include "shared_tracked_frame.h"
 
 namespace alvio_ros {
 
-class LoggerNodelet : public nodelet::Nodelet {
+class LoggerNodelet : public GuardedNodelet {
  public:
   ~LoggerNodelet() override {
     log_route_.clearListener();
@@ -40,16 +41,7 @@ class LoggerNodelet : public nodelet::Nodelet {
   }
 
  private:
-  void onInit() override {
-    try {
-      init();
-    } catch (const std::exception& e) {
-      NODELET_FATAL("%s not loaded: %s", getName().c_str(), e.what());
-      throw;
-    }
-  }
-
-  void init() {
+  void init() override {
     ros::NodeHandle& nh = getNodeHandle();
     ros::NodeHandle& pnh = getPrivateNodeHandle();
     const NodeletConfig config(nh, pnh);

@@ -19,11 +19,12 @@
 #include "alvio/mapping/occupancy_map.h"
 #include "conversions.h"
 #include "core_log_route.h"
+#include "guarded_nodelet.h"
 #include "nodelet_config.h"
 
 namespace alvio_ros {
 
-class MappingNodelet : public nodelet::Nodelet {
+class MappingNodelet : public GuardedNodelet {
  public:
   ~MappingNodelet() override {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -31,16 +32,7 @@ class MappingNodelet : public nodelet::Nodelet {
   }
 
  private:
-  void onInit() override {
-    try {
-      init();
-    } catch (const std::exception& e) {
-      NODELET_FATAL("%s not loaded: %s", getName().c_str(), e.what());
-      throw;
-    }
-  }
-
-  void init() {
+  void init() override {
     ros::NodeHandle& nh = getNodeHandle();
     ros::NodeHandle& pnh = getPrivateNodeHandle();
     const NodeletConfig config(nh, pnh);

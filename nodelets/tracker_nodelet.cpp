@@ -16,24 +16,15 @@
 #include "alvio/pipeline/front_end.h"
 #include "conversions.h"
 #include "core_log_route.h"
+#include "guarded_nodelet.h"
 #include "nodelet_config.h"
 #include "shared_tracked_frame.h"
 
 namespace alvio_ros {
 
-class TrackerNodelet : public nodelet::Nodelet {
+class TrackerNodelet : public GuardedNodelet {
  private:
-  void onInit() override {
-    try {
-      init();
-    } catch (const std::exception& e) {
-      // Thrown on: the manager unloads this nodelet and keeps running.
-      NODELET_FATAL("%s not loaded: %s", getName().c_str(), e.what());
-      throw;
-    }
-  }
-
-  void init() {
+  void init() override {
     ros::NodeHandle& nh = getNodeHandle();
     ros::NodeHandle& pnh = getPrivateNodeHandle();
     const NodeletConfig config(nh, pnh);

@@ -14,26 +14,22 @@
 #include <map>
 
 #include "conversions.h"
+#include "guarded_nodelet.h"
 #include "nodelet_config.h"
 #include "shared_tracked_frame.h"
 
 namespace alvio_ros {
 
-class ZeroCopyMonitorNodelet : public nodelet::Nodelet {
+class ZeroCopyMonitorNodelet : public GuardedNodelet {
  private:
-  void onInit() override {
-    try {
-      ros::NodeHandle& nh = getNodeHandle();
-      ros::NodeHandle& pnh = getPrivateNodeHandle();
-      const std::string image_topic = param(pnh, "image_topic", "/cam0/image_raw");
-      const std::string frame_topic = param(pnh, "frame_topic", "tracker/frame");
-      report_pub_ = pnh.advertise<alvio::ZeroCopyReport>("report", 1, true);
-      image_sub_ = nh.subscribe(image_topic, 20, &ZeroCopyMonitorNodelet::onImage, this);
-      frame_sub_ = nh.subscribe(frame_topic, 20, &ZeroCopyMonitorNodelet::onFrame, this);
-    } catch (const std::exception& e) {
-      NODELET_FATAL("%s not loaded: %s", getName().c_str(), e.what());
-      throw;
-    }
+  void init() override {
+    ros::NodeHandle& nh = getNodeHandle();
+    ros::NodeHandle& pnh = getPrivateNodeHandle();
+    const std::string image_topic = param(pnh, "image_topic", "/cam0/image_raw");
+    const std::string frame_topic = param(pnh, "frame_topic", "tracker/frame");
+    report_pub_ = pnh.advertise<alvio::ZeroCopyReport>("report", 1, true);
+    image_sub_ = nh.subscribe(image_topic, 20, &ZeroCopyMonitorNodelet::onImage, this);
+    frame_sub_ = nh.subscribe(frame_topic, 20, &ZeroCopyMonitorNodelet::onFrame, this);
   }
 
   void onImage(const sensor_msgs::ImageConstPtr& image) {
