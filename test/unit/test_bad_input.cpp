@@ -127,6 +127,18 @@ TEST(BadConfig, WrongTypeNamesKeyAndValue) {
   EXPECT_MENTIONS(msg, "list");
 }
 
+// fuzz_config found this one: a resolution beyond int's range was undefined behaviour.
+TEST(BadConfig, ResolutionOutOfRangeNamesKeyAndValue) {
+  const std::string dir = test::scratchDir();
+  for (const char* bad :
+       {"resolution: [6e81, 480]", "resolution: [752, -480]", "resolution: [752.5, 480]"}) {
+    const std::string msg =
+        errorOf([&] { Config::load(configReplacing(dir, "resolution: [752, 480]", bad)); });
+    EXPECT_MENTIONS(msg, "camera.resolution");
+    EXPECT_MENTIONS(msg, "whole numbers");
+  }
+}
+
 TEST(BadConfig, NegativeNoiseNamesKeyAndValue) {
   const std::string path =
       configReplacing(test::scratchDir(), "gyroscope_noise_density: 1.6968e-04",

@@ -31,6 +31,15 @@ CameraOptions CameraOptions::load(const YamlReader& yaml, const std::string& pre
   o.camera_model = yaml.getString(p + "camera_model", o.camera_model);
   o.distortion_model = yaml.getString(p + "distortion_model");
   const auto resolution = yaml.getDoubles(p + "resolution", 2);
+  // Checked before the conversion to int: a huge value would be undefined behaviour there
+  // (found by fuzz_config).
+  for (double v : resolution)
+    if (!(v >= 1 && v <= 65536) || v != std::floor(v)) {
+      std::ostringstream os;
+      os << yaml.where(p + "resolution")
+         << " must be two whole numbers of pixels in [1, 65536], got " << v;
+      throw Error(os.str());
+    }
   o.width = static_cast<int>(resolution[0]);
   o.height = static_cast<int>(resolution[1]);
   o.intrinsics = yaml.getDoubles(p + "intrinsics", 4);
