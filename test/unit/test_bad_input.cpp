@@ -264,3 +264,16 @@ TEST(StillStart, WaitsForMotionAndPublishesNoPose) {
   const auto summary = nlohmann::json::parse(readFile(out + "/summary.json"));
   EXPECT_EQ(summary["poses"], 0);
 }
+
+// fuzz_config found this one: a complex (non-scalar) mapping key made unknownKeys() throw
+// from a path that must not, which terminated the program.
+TEST(BadConfig, ComplexKeyIsReportedAsUnknownWithoutThrowing) {
+  const YamlReader yaml =
+      YamlReader::fromString("camera:\n  ? [a, b]\n  : 1\n  rate_hz: 20\n", "complex.yaml");
+  EXPECT_EQ(yaml.getDouble("camera.rate_hz"), 20.0);
+  std::vector<std::string> unknown;
+  EXPECT_NO_THROW(unknown = yaml.unknownKeys());
+  ASSERT_EQ(unknown.size(), 1u);
+  EXPECT_MENTIONS(unknown[0], "camera.");
+  EXPECT_NO_THROW(yaml.warnUnknownKeys());
+}

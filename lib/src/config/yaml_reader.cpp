@@ -35,7 +35,9 @@ void collectKeys(const YAML::Node& node, const std::string& prefix, std::vector<
     return;
   }
   for (const auto& kv : node) {
-    const std::string name = kv.first.as<std::string>();
+    // A complex key ("? [a, b]: x") is not a scalar: name it by its YAML text instead of
+    // throwing from here (found by fuzz_config; unknownKeys runs in noexcept paths).
+    const std::string name = kv.first.IsScalar() ? kv.first.Scalar() : YAML::Dump(kv.first);
     collectKeys(kv.second, prefix.empty() ? name : prefix + "." + name, out);
   }
 }
