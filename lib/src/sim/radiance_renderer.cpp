@@ -7,24 +7,10 @@
 #include <vector>
 
 #include "alvio/common/error.h"
+#include "alvio/sim/parallel_for.h"
 
 namespace alvio::sim {
-namespace {
-
-// f(k) for k in [0, n) over `threads` threads, interleaved (deterministic output).
-template <typename F>
-void parallelFor(int n, int threads, F&& f) {
-  threads = std::max(1, std::min(threads, n));
-  std::vector<std::thread> pool;
-  for (int k = 1; k < threads; ++k)
-    pool.emplace_back([&, k] {
-      for (int i = k; i < n; i += threads) f(i);
-    });
-  for (int i = 0; i < n; i += threads) f(i);
-  for (auto& t : pool) t.join();
-}
-
-}  // namespace
+namespace {}  // namespace
 
 RadianceRenderer::RadianceRenderer(const Scene& scene, const SceneAppearance& appearance,
                                    const CameraRayTable& rays)

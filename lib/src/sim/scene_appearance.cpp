@@ -4,23 +4,11 @@
 #include <cmath>
 #include <thread>
 
+#include "alvio/sim/parallel_for.h"
 #include "alvio/sim/seeded_random.h"
 
 namespace alvio::sim {
 namespace {
-
-// Run f(i) for i in [0, n) on `threads` threads (static interleaving, deterministic).
-template <typename F>
-void parallelFor(int n, int threads, F&& f) {
-  threads = std::max(1, std::min(threads, n));
-  std::vector<std::thread> pool;
-  for (int k = 1; k < threads; ++k)
-    pool.emplace_back([&, k] {
-      for (int i = k; i < n; i += threads) f(i);
-    });
-  for (int i = 0; i < n; i += threads) f(i);
-  for (auto& t : pool) t.join();
-}
 
 // Irradiance at p (normal n) from the scene's lights, with shadow rays.
 float irradianceAt(const Scene& scene, const Eigen::Vector3d& p, const Eigen::Vector3d& n,
