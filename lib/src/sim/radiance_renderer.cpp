@@ -10,7 +10,6 @@
 #include "alvio/sim/parallel_for.h"
 
 namespace alvio::sim {
-namespace {}  // namespace
 
 RadianceRenderer::RadianceRenderer(const Scene& scene, const SceneAppearance& appearance,
                                    const CameraRayTable& rays)
