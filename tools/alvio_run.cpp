@@ -101,6 +101,9 @@ int main(int argc, char** argv) {
 
     std::cout << "frames: " << r.frames << ", poses: " << r.poses << ", resets: " << r.resets
               << ", skipped images: " << r.skipped_images << "\n";
+    if (r.dropped_images + r.dropped_imu > 0)
+      std::cout << "dropped (out of order or not finite): " << r.dropped_images << " images, "
+                << r.dropped_imu << " IMU samples\n";
     if (r.initialization) {
       const auto& q = *r.initialization;
       std::cout << "initialised at " << std::fixed << q.time << " s (" << q.since_motion_s

@@ -4,11 +4,13 @@
 
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <random>
 
 #include "alvio/common/error.h"
+#include "alvio/common/log_throttle.h"
 #include "alvio/config/config.h"
 #include "alvio/config/yaml_reader.h"
 #include "alvio/io/euroc_dataset.h"
@@ -276,4 +278,97 @@ TEST(BadConfig, ComplexKeyIsReportedAsUnknownWithoutThrowing) {
   ASSERT_EQ(unknown.size(), 1u);
   EXPECT_MENTIONS(unknown[0], "camera.");
   EXPECT_NO_THROW(yaml.warnUnknownKeys());
+}
+
+// --- broken streams (what a bag or driver delivers on a bad day) -------------------------
+
+namespace {
+
+// Messages as given, in the given order: a recorded stream with faults in it.
+class ListSource : public SensorSource {
+ public:
+  explicit ListSource(std::vector<SensorMessage> messages) : messages_(std::move(messages)) {
+    for (const auto& m : messages_) images_ += m.kind == SensorMessage::Kind::kImage;
+  }
+  bool next(SensorMessage* m) override {
+    if (i_ >= messages_.size()) return false;
+    *m = messages_[i_++];
+    return true;
+  }
+  std::size_t imageCount() const override { return images_; }
+  std::string description() const override { return "test stream"; }
+
+ private:
+  std::vector<SensorMessage> messages_;
+  std::size_t i_ = 0, images_ = 0;
+};
+
+SensorMessage imuAt(int64_t t_ns, double acc_z = 9.81) {
+  SensorMessage m;
+  m.kind = SensorMessage::Kind::kImu;
+  m.t_ns = m.imu.t_ns = t_ns;
+  m.imu.acc = {0, 0, acc_z};
+  return m;
+}
+
+SensorMessage imageAt(int64_t t_ns) {
+  SensorMessage m;
+  m.kind = SensorMessage::Kind::kImage;
+  m.t_ns = t_ns;
+  m.load_image = [t_ns] {
+    cv::Mat image(480, 752, CV_8UC1);
+    cv::theRNG().state = static_cast<uint64_t>(t_ns);
+    cv::randu(image, 0, 255);
+    return image;
+  };
+  return m;
+}
+
+}  // namespace
+
+TEST(BadStream, NonFiniteAndOutOfOrderMessagesAreDroppedAndCounted) {
+  const int64_t t0 = 1'000'000'000'000, imu_dt = 5'000'000, frame_dt = 50'000'000;
+  std::vector<SensorMessage> messages;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  int expected_imu_drops = 0;
+  for (int i = 0; i <= 200; ++i) {
+    const int64_t t = t0 + i * imu_dt;
+    if (i % 10 == 0) messages.push_back(imageAt(t));
+    if (i >= 50 && i < 60) {  // a NaN burst, then Inf
+      messages.push_back(imuAt(t, i < 55 ? nan : std::numeric_limits<double>::infinity()));
+      ++expected_imu_drops;
+    } else {
+      messages.push_back(imuAt(t));
+    }
+    if (i == 100 || i == 101) {  // a duplicate stamp, and a sample from the past
+      messages.push_back(imuAt(i == 100 ? t : t - 20 * imu_dt));
+      ++expected_imu_drops;
+    }
+  }
+  // Two images stamped back in time, as a glitching driver would send them.
+  messages.insert(messages.begin() + messages.size() / 2, imageAt(t0 + frame_dt / 2));
+  messages.insert(messages.begin() + messages.size() / 2 + 5, imageAt(t0 + 3 * frame_dt));
+
+  ListSource source(messages);
+  const std::string out = test::scratchDir() + "/out";
+  const RunResult r = runOffline(source, defaultConfig(), quietRun(out));
+  EXPECT_EQ(r.dropped_imu, static_cast<std::size_t>(expected_imu_drops));
+  EXPECT_EQ(r.dropped_images, 2u);
+  EXPECT_EQ(r.frames, 21u);  // every in-order image, none of the two from the past
+  for (const auto& p : r.trajectory) EXPECT_TRUE(p.p.allFinite() && p.q.coeffs().allFinite());
+  const auto summary = nlohmann::json::parse(readFile(out + "/summary.json"));
+  EXPECT_EQ(summary["dropped_imu"], expected_imu_drops);
+  EXPECT_EQ(summary["dropped_images"], 2);
+}
+
+TEST(LogThrottle, OneLinePerPeriodCountingWhatItStandsFor) {
+  LogThrottle throttle(2.0);
+  std::size_t n = 0;
+  EXPECT_TRUE(throttle.shouldLog(10.0, &n));
+  EXPECT_EQ(n, 1u);
+  for (double t = 10.1; t < 11.95; t += 0.1) EXPECT_FALSE(throttle.shouldLog(t, &n));
+  EXPECT_TRUE(throttle.shouldLog(12.0, &n));
+  EXPECT_EQ(n, 20u);  // the 19 held back and this one
+  EXPECT_TRUE(throttle.shouldLog(3.0, &n)) << "time going back starts afresh";
+  EXPECT_EQ(throttle.total(), 22u);
 }

@@ -82,15 +82,18 @@ std::vector<EstimatorEvent> Estimator::takeEvents() {
 }
 
 void Estimator::addImu(const ImuSample& s) {
+  std::size_t n = 0;
   if (has_imu_ || !imu_queue_.empty()) {
     if (s.t_ns <= last_queued_imu_ns_) {
-      logWarn("IMU sample at ", s.t_ns, " ns is not after the previous one (", last_queued_imu_ns_,
-              " ns): dropped");
+      if (imu_late_.shouldLog(s.t_ns * 1e-9, &n))
+        logWarn(n, " IMU sample(s) not after the previous one dropped (latest at ", s.t_ns,
+                " ns, previous ", last_queued_imu_ns_, " ns)");
       return;
     }
   }
   if (!s.acc.allFinite() || !s.gyr.allFinite()) {
-    logWarn("IMU sample at ", s.t_ns, " ns has a NaN or Inf value: dropped");
+    if (imu_nonfinite_.shouldLog(s.t_ns * 1e-9, &n))
+      logWarn(n, " IMU sample(s) with a NaN or Inf value dropped (latest at ", s.t_ns, " ns)");
     return;
   }
   last_queued_imu_ns_ = s.t_ns;

@@ -132,6 +132,7 @@ RunResult runOffline(SensorSource& source, const Config& config, const RunOption
       return;
     }
     PipelineOutput out = pipeline.addImage(image, m.t_ns);
+    if (out.dropped) return;
     ++result.frames;
     result.timing.add(out.timing);
     for (const auto& e : out.events) {
@@ -190,6 +191,8 @@ RunResult runOffline(SensorSource& source, const Config& config, const RunOption
                       : "");
   if (result.interrupted) logWarn("run stopped early: writing the results so far");
   result.resets = pipeline.estimator().resetCount();
+  result.dropped_images = pipeline.droppedImages();
+  result.dropped_imu = pipeline.estimator().droppedImu();
   result.poses = result.trajectory.size();
 
   writeTumTrajectory((fs::path(options.out_dir) / "trajectory.tum").string(), result.trajectory);
@@ -203,6 +206,8 @@ RunResult runOffline(SensorSource& source, const Config& config, const RunOption
   summary["frames"] = result.frames;
   summary["poses"] = result.poses;
   summary["skipped_images"] = result.skipped_images;
+  summary["dropped_images"] = result.dropped_images;
+  summary["dropped_imu"] = result.dropped_imu;
   summary["resets"] = result.resets;
   summary["interrupted"] = result.interrupted;
   for (const auto& s : result.timing.summary())

@@ -1,5 +1,7 @@
 #include "alvio/pipeline/vio_pipeline.h"
 
+#include "alvio/common/logging.h"
+
 namespace alvio {
 
 VioPipeline::VioPipeline(const Config& config)
@@ -10,6 +12,15 @@ VioPipeline::VioPipeline(const Config& config)
 PipelineOutput VioPipeline::addImage(const cv::Mat& gray, int64_t t_ns) {
   PipelineOutput out;
   out.timing.t = t_ns * 1e-9;
+  if (last_image_ns_ != 0 && t_ns <= last_image_ns_) {
+    std::size_t n = 0;
+    if (images_late_.shouldLog(t_ns * 1e-9, &n))
+      logWarn(n, " image(s) not after the previous one dropped (latest at ", t_ns, " ns, previous ",
+              last_image_ns_, " ns)");
+    out.dropped = true;
+    return out;
+  }
+  last_image_ns_ = t_ns;
   out.features = front_end_.track(gray, t_ns, &out.timing);
   const int resets_before = estimator_.resetCount();
   out.has_pose = estimator_.addFrame(out.features, &out.timing);

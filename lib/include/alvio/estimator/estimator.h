@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "alvio/common/log_throttle.h"
 #include "alvio/common/timing.h"
 #include "alvio/common/types.h"
 #include "alvio/config/sensor_options.h"
@@ -116,6 +117,8 @@ class Estimator {
   /// with the final poses of every frame that saw it (for maps). Output frame.
   LineSegments3 takeRetiredLines();
   int resetCount() const { return reset_count_; }
+  /// IMU samples dropped by addImu: not after the previous one, or not finite.
+  std::size_t droppedImu() const { return imu_late_.total() + imu_nonfinite_.total(); }
   /// Window records since the last call (only when options.record_analysis).
   std::vector<WindowTrackRecord> takeWindowRecords();
   /// Events since the last call (moved out).
@@ -211,6 +214,7 @@ class Estimator {
   double imu_time_ = 0;  // time of the last sample fed to processImu
   Eigen::Vector3d acc_0_ = Eigen::Vector3d::Zero(), gyr_0_ = Eigen::Vector3d::Zero();
   int64_t last_queued_imu_ns_ = 0;
+  LogThrottle imu_late_, imu_nonfinite_;  // dropped samples, warned about once per 2 s
 
   double last_init_attempt_ = -1e9;
   double first_moving_attempt_ = -1;  ///< when the relaxed parallax was first seen

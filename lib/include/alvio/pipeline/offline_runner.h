@@ -46,6 +46,8 @@ struct InitializationQuality {
 
 struct RunResult {
   std::size_t frames = 0, poses = 0, skipped_images = 0;
+  /// Messages dropped as out of order (stamp not after the previous one) or not finite.
+  std::size_t dropped_images = 0, dropped_imu = 0;
   int resets = 0;
   bool interrupted = false;  ///< stopped early by RunOptions::stop
   Trajectory trajectory;

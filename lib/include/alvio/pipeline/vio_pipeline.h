@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "alvio/camera/camera_model.h"
+#include "alvio/common/log_throttle.h"
 #include "alvio/common/timing.h"
 #include "alvio/config/config.h"
 #include "alvio/estimator/estimator.h"
@@ -17,6 +18,7 @@ namespace alvio {
 
 struct PipelineOutput {
   bool has_pose = false;  ///< false until initialised, and on the frame of a reset
+  bool dropped = false;   ///< the image was not after the previous one: not processed
   BodyState state;        ///< newest frame, output world frame
   EstimatorStatus status = EstimatorStatus::kInitializing;
   FeatureFrame features;
@@ -36,8 +38,11 @@ class VioPipeline {
 
   void addImu(const ImuSample& sample) { estimator_.addImu(sample); }
   /// Track and estimate one 8-bit grey image. IMU up to (and one sample beyond) its time
-  /// should have been added.
+  /// should have been added. An image not after the previous one is dropped (a stamp
+  /// going back would run the tracker and the IMU integration backwards).
   PipelineOutput addImage(const cv::Mat& gray, int64_t t_ns);
+
+  std::size_t droppedImages() const { return images_late_.total(); }
 
   const Estimator& estimator() const { return estimator_; }
   const CameraModel& camera() const { return front_end_.camera(); }
@@ -46,6 +51,8 @@ class VioPipeline {
   Config config_;
   FrontEnd front_end_;
   Estimator estimator_;
+  int64_t last_image_ns_ = 0;
+  LogThrottle images_late_;
 };
 
 }  // namespace alvio
