@@ -261,7 +261,7 @@ class EstimatorNodelet : public GuardedNodelet {
     status->reset_count = estimator_->resetCount();
     status->frames = frames_;
     status->dropped_frames = static_cast<uint32_t>(dropped_frames_);
-    status->dropped_imu = static_cast<uint32_t>(dropped_imu_);
+    status->dropped_imu = static_cast<uint32_t>(dropped_imu_ + estimator_->droppedImu());
     status->tracked_points = static_cast<int32_t>(features.points.size());
     status->window_points = static_cast<int32_t>(estimator_->points().landmarks().size());
     status->window_lines = static_cast<int32_t>(estimator_->lineSegments().size());

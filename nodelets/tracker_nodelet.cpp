@@ -17,6 +17,7 @@
 #include "conversions.h"
 #include "core_log_route.h"
 #include "guarded_nodelet.h"
+#include "image_message_check.h"
 #include "nodelet_config.h"
 #include "shared_tracked_frame.h"
 
@@ -52,6 +53,12 @@ class TrackerNodelet : public GuardedNodelet {
   }
 
   void onImage(const sensor_msgs::ImageConstPtr& image) {
+    const std::string problem = imageMessageProblem(*image);
+    if (!problem.empty()) {
+      NODELET_ERROR_THROTTLE(5.0, "image at %.3f s is malformed: %s: skipped",
+                             image->header.stamp.toSec(), problem.c_str());
+      return;
+    }
     cv_bridge::CvImageConstPtr gray;
     try {
       // mono8 is shared, not copied; other encodings are converted.

@@ -5,9 +5,12 @@
 # wrote, and where every output file is.
 #
 #   scripts/ros_demo.sh [--rate R] [--out DIR]      (./alvio demo builds first)
+#   scripts/ros_demo.sh --bag FILE [--groundtruth TUM] [--record-status] ...
 #
 # The demo sequence comes from $ALVIO_DEMO_DATA, out/demo/sim, ../data/demo, or is
-# rendered with alvio_sim --demo when that tool is built.
+# rendered with alvio_sim --demo when that tool is built. --bag plays another bag instead
+# (the ATE needs --groundtruth); --record-status keeps the estimator's status messages in
+# <out>/run/status.bag (the fault-injection suite reads them).
 set -euo pipefail
 
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -15,11 +18,17 @@ BUILD="${ALVIO_BUILD_DIR:-$ROOT/build}"
 BIN="$BUILD/devel/lib/alvio"
 rate=0.5  # the front end needs ~45 ms per frame on 2 busy cores: real time is too tight
 out="$ROOT/out/demo"
+bag=""
+gt=""
+record_status=false
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --rate) rate="$2"; shift 2 ;;
     --out) out="$2"; shift 2 ;;
-    -h|--help) sed -n '2,12p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --bag) bag="$2"; shift 2 ;;
+    --groundtruth) gt="$2"; shift 2 ;;
+    --record-status) record_status=true; shift ;;
+    -h|--help) sed -n '2,16p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "demo: unknown option $1" >&2; exit 2 ;;
   esac
 done
@@ -35,22 +44,27 @@ set +u
 source "$BUILD/devel/setup.bash"
 set -u
 
-# The input: the simulator's demo folder, as a bag.
-demo=""
-for d in "${ALVIO_DEMO_DATA:-}" "$ROOT/out/demo/sim" "$ROOT/../data/demo"; do
-  if [[ -n $d && -f $d/mav0/cam0/data.csv ]]; then demo="$(cd "$d" && pwd)"; break; fi
-done
-if [[ -z $demo ]]; then
-  [[ -x $BIN/alvio_sim ]] || die "no demo sequence (set ALVIO_DEMO_DATA) and no alvio_sim to render one"
-  log "rendering the demo sequence into $ROOT/out/demo/sim"
-  "$BIN/alvio_sim" --demo "$ROOT/out/demo/sim"
-  demo="$ROOT/out/demo/sim"
-fi
 mkdir -p "$out"
-bag="$out/demo.bag"
-if [[ ! -f $bag || $demo/mav0/cam0/data.csv -nt $bag ]]; then
-  log "writing $bag from $demo"
-  "$BIN/alvio_euroc_to_bag" --dataset "$demo" --out "$bag" --groundtruth "$out/groundtruth.tum"
+if [[ -n $bag ]]; then
+  [[ -f $bag ]] || die "no bag '$bag'"
+else
+  # The input: the simulator's demo folder, as a bag.
+  demo=""
+  for d in "${ALVIO_DEMO_DATA:-}" "$ROOT/out/demo/sim" "$ROOT/../data/demo"; do
+    if [[ -n $d && -f $d/mav0/cam0/data.csv ]]; then demo="$(cd "$d" && pwd)"; break; fi
+  done
+  if [[ -z $demo ]]; then
+    [[ -x $BIN/alvio_sim ]] || die "no demo sequence (set ALVIO_DEMO_DATA) and no alvio_sim to render one"
+    log "rendering the demo sequence into $ROOT/out/demo/sim"
+    "$BIN/alvio_sim" --demo "$ROOT/out/demo/sim"
+    demo="$ROOT/out/demo/sim"
+  fi
+  bag="$out/demo.bag"
+  gt="$out/groundtruth.tum"
+  if [[ ! -f $bag || $demo/mav0/cam0/data.csv -nt $bag ]]; then
+    log "writing $bag from $demo"
+    "$BIN/alvio_euroc_to_bag" --dataset "$demo" --out "$bag" --groundtruth "$gt"
+  fi
 fi
 
 # A private master on a free port, so that runs never collide with another roscore.
@@ -69,6 +83,10 @@ for _ in $(seq 100); do
 done
 rosparam get /rosdistro >/dev/null 2>&1 || die "roscore did not start (see $out/roscore.log)"
 
+if $record_status; then
+  rosbag record --quiet -O "$run/status.bag" /alvio/estimator/status __name:=status_recorder \
+    >"$out/status_record.log" 2>&1 &
+fi
 log "playing $(basename "$bag") at rate $rate through the nodelet pipeline (master $ROS_MASTER_URI)"
 start=$(date +%s)
 roslaunch alvio sim.launch bag:="$bag" rate:="$rate" output_dir:="$run" logging:=true \
@@ -88,9 +106,14 @@ done
 sleep 3
 kill -INT "$launch_pid"
 wait "$launch_pid" || true
+if $record_status; then rosnode kill /status_recorder >/dev/null 2>&1 || true; fi
 log "pipeline finished in $(($(date +%s) - start)) s"
 
 [[ -s $run/trajectory.tum ]] || die "no trajectory written (see $out/roslaunch.log)"
+if [[ -z $gt ]]; then
+  echo "trajectory: $run/trajectory.tum ($(wc -l <"$run/trajectory.tum") poses; no ground truth given)"
+  exit 0
+fi
 "$BIN/alvio_eval" --gt "$out/groundtruth.tum" --est "$run/trajectory.tum" --align se3 \
   --json "$run/eval.json" --plot "$run" >"$run/eval.txt"
 ate=$(python3 -c 'import json, sys; print("%.4f" % json.load(open(sys.argv[1]))["ate_translation_m"]["rmse"])' "$run/eval.json")

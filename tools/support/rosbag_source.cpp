@@ -12,6 +12,7 @@
 
 #include "alvio/common/error.h"
 #include "alvio/common/logging.h"
+#include "image_message_check.h"
 
 namespace alvio {
 
@@ -124,6 +125,11 @@ bool RosbagSource::nextMessage(SensorMessage* m) {
     m->kind = SensorMessage::Kind::kImage;
     m->t_ns = static_cast<int64_t>(image->header.stamp.toNSec());
     m->load_image = [image]() -> cv::Mat {
+      const std::string problem = alvio_ros::imageMessageProblem(*image);
+      if (!problem.empty()) {
+        logWarn("image message at ", image->header.stamp, " is malformed: ", problem);
+        return cv::Mat();
+      }
       try {
         const auto cv_image = cv_bridge::toCvShare(image);
         if (cv_image->image.type() == CV_8UC1) return cv_image->image.clone();
