@@ -148,7 +148,7 @@ class EstimatorNodelet : public GuardedNodelet {
     {
       std::lock_guard<std::mutex> lock(mutex_);
       const int64_t t_ns = toNs(msg->features.header.stamp);
-      if (newest_ns_ != 0 && t_ns > newest_ns_ + kJumpBackNs) {
+      if (newest_ns_ != 0 && t_ns > newest_ns_ + kNewRunJumpBackNs) {
         // Tracked before the time jump that restarted the run: not part of the new run.
         NODELET_WARN_THROTTLE(2.0, "frame at %.3f s is over 1 s ahead of the IMU: dropped",
                               t_ns * 1e-9);
@@ -175,7 +175,7 @@ class EstimatorNodelet : public GuardedNodelet {
   // The IMU decides, as it comes straight from the sensor; frames lag behind the tracker.
   // Called under mutex_.
   void jumpedBack(int64_t t_ns) {
-    if (newest_ns_ != 0 && t_ns + kJumpBackNs < newest_ns_) {
+    if (newest_ns_ != 0 && t_ns + kNewRunJumpBackNs < newest_ns_) {
       sync_ = Sync(sync_.options());
       restart_ = true;
       newest_ns_ = t_ns;
@@ -404,7 +404,6 @@ class EstimatorNodelet : public GuardedNodelet {
   Sync sync_;
   bool stop_ = false, restart_ = false;
   int64_t newest_ns_ = 0;  // newest IMU stamp
-  static constexpr int64_t kJumpBackNs = 1000000000;
 
   // The worker's.
   std::thread worker_;

@@ -47,6 +47,7 @@ class MappingNodelet : public GuardedNodelet {
     requireParam(period > 0, pnh, "publish_period", "must be positive");
     requireParam(!world_frame_.empty(), pnh, "world_frame", "is empty");
     max_line_std_deg_ = options.max_line_direction_std_deg;
+    options_ = options;
     map_ = std::make_unique<alvio::MapBuilder>(options);
 
     lines_pub_ = pnh.advertise<visualization_msgs::MarkerArray>("lines", 1, true);
@@ -63,16 +64,33 @@ class MappingNodelet : public GuardedNodelet {
 
   void onKeyframe(const alvio::MapKeyframe::ConstPtr& msg) {
     std::lock_guard<std::mutex> lock(mutex_);
+    startNewRunIfTimeJumpedBack(msg->header.stamp);
     map_->addKeyframe(fromMsg(*msg, max_line_std_deg_));
     changed_since_publish_ = changed_since_save_ = true;
   }
 
   void onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
     std::lock_guard<std::mutex> lock(mutex_);
+    startNewRunIfTimeJumpedBack(msg->header.stamp);
     const Eigen::Isometry3d T = fromPose(msg->pose.pose);
     map_->addTrajectoryPose(
         {msg->header.stamp.toSec(), T.translation(), Eigen::Quaterniond(T.rotation())});
     changed_since_save_ = true;
+  }
+
+  // The estimator starts a new run, in a new world frame, when time jumps back (a bag played
+  // again): so does the map, as a map mixing two frames is worth nothing. Like the
+  // estimator's trajectory, what is saved is the latest run's. Called under mutex_.
+  void startNewRunIfTimeJumpedBack(const ros::Time& stamp) {
+    const int64_t t_ns = toNs(stamp);
+    if (newest_ns_ != 0 && t_ns + kNewRunJumpBackNs < newest_ns_) {
+      NODELET_WARN("time jumped back %.1f s: the map starts afresh (new run)",
+                   (newest_ns_ - t_ns) * 1e-9);
+      map_ = std::make_unique<alvio::MapBuilder>(options_);
+      newest_ns_ = t_ns;
+      changed_since_publish_ = changed_since_save_ = true;
+    }
+    newest_ns_ = std::max(newest_ns_, t_ns);
   }
 
   // Throttled, latched: a display that connects later still gets the last map.
@@ -124,7 +142,9 @@ class MappingNodelet : public GuardedNodelet {
 
   CoreLogRoute log_route_;
   std::mutex mutex_;  // the timer, callbacks and service share one queue; the destructor not
+  alvio::MappingOptions options_;
   std::unique_ptr<alvio::MapBuilder> map_;
+  int64_t newest_ns_ = 0;  // newest keyframe or odometry stamp
   std::string output_dir_, world_frame_, last_error_;
   bool save_on_shutdown_ = true, changed_since_publish_ = false, changed_since_save_ = false;
   double max_line_std_deg_ = 2.0;

@@ -76,7 +76,7 @@ class TrackerNodelet : public GuardedNodelet {
       return;
     }
     const int64_t t_ns = toNs(image->header.stamp);
-    if (last_t_ns_ != 0 && t_ns + kJumpBackNs < last_t_ns_) {
+    if (last_t_ns_ != 0 && t_ns + kNewRunJumpBackNs < last_t_ns_) {
       // A bag played again, or a restarted simulation: a new run.
       NODELET_WARN("time jumped back %.1f s: the front end starts afresh",
                    (last_t_ns_ - t_ns) * 1e-9);
@@ -112,8 +112,6 @@ class TrackerNodelet : public GuardedNodelet {
     if (status->reset_count > reset_count_) reset_pending_ = true;
     reset_count_ = status->reset_count;
   }
-
-  static constexpr int64_t kJumpBackNs = 1000000000;
 
   CoreLogRoute log_route_;
   alvio::Config config_;

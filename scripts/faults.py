@@ -400,10 +400,6 @@ def run_nodelet(args, env, bag, fault, run_dir, timeout):
         res.update(resets=int(last.reset_count), frames=int(last.frames),
                    dropped_images=int(last.dropped_frames), dropped_imu=int(last.dropped_imu),
                    reset_statuses=sum(1 for m in statuses if m.state == m.RESET))
-    # Messages the tracker refused (wrong size/encoding) never reach the estimator's count.
-    res["refused_images"] = sum(launch_log.count(k) for k in ("cannot be converted",
-                                                              "but camera.resolution is",
-                                                              "is malformed"))
     return res
 
 
@@ -412,15 +408,16 @@ def fmt(v, spec="{:.3f}"):
 
 
 def table(results):
-    lines = ["| fault | mode | completed | resets | ATE before (m) | ATE from fault (m) | "
+    lines = ["| fault | mode | completed | frames | resets | ATE before (m) | ATE from fault (m) | "
              "tracking lost | recovery (s) | dropped img / IMU | NaN poses |",
-             "|---|---|---|---|---|---|---|---|---|---|"]
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in results:
         done = "yes" if r.get("completed") else f"**no**: {r.get('why', '')}"
         lost = "—" if "tracking_lost" not in r else ("yes" if r["tracking_lost"] else "no")
         dropped = "—" if "dropped_images" not in r else \
             f"{r['dropped_images']} / {r.get('dropped_imu', 0)}"
-        lines.append(f"| {r['fault']} | {r['mode']} | {done} | {r.get('resets', '—')} | "
+        lines.append(f"| {r['fault']} | {r['mode']} | {done} | {r.get('frames', '—')} | "
+                     f"{r.get('resets', '—')} | "
                      f"{fmt(r.get('ate_before_m'))} | {fmt(r.get('ate_after_m'))} | {lost} | "
                      f"{fmt(r.get('recovery_s'), '{:.2f}')} | {dropped} | "
                      f"{r.get('nan_poses', '—')} |")

@@ -86,19 +86,21 @@ rosparam get /rosdistro >/dev/null 2>&1 || die "roscore did not start (see $out/
 if $record_status; then
   rosbag record --quiet -O "$run/status.bag" /alvio/estimator/status __name:=status_recorder \
     >"$out/status_record.log" 2>&1 &
+  record_pid=$!
 fi
 log "playing $(basename "$bag") at rate $rate through the nodelet pipeline (master $ROS_MASTER_URI)"
 start=$(date +%s)
 roslaunch alvio sim.launch bag:="$bag" rate:="$rate" output_dir:="$run" logging:=true \
   exit_at_end:=false >"$out/roslaunch.log" 2>&1 &
 launch_pid=$!
-trap 'kill -INT "$launch_pid" 2>/dev/null || true; kill "$core_pid" 2>/dev/null || true; wait 2>/dev/null || true' EXIT
+trap 'kill -INT "$launch_pid" ${record_pid:-} 2>/dev/null || true; kill "$core_pid" 2>/dev/null || true; wait 2>/dev/null || true' EXIT
 # The player appears, plays and leaves; then the estimator gets 1 s without frames to hand
 # the window to the map (flush_after_s) before the pipeline shuts down and writes its files.
 # (grep reads a captured list: under pipefail, `rosnode list | grep -q` fails at random when
 # grep quits first and rosnode list dies of SIGPIPE.)
 player_up() { local nodes; nodes=$(rosnode list 2>/dev/null || true); grep -q '^/player$' <<<"$nodes"; }
 for _ in $(seq 150); do player_up && break; sleep 0.2; done
+kill -0 "$launch_pid" 2>/dev/null || die "roslaunch ended early (see $out/roslaunch.log)"
 while player_up; do
   kill -0 "$launch_pid" 2>/dev/null || die "roslaunch ended early (see $out/roslaunch.log)"
   sleep 1

@@ -4,14 +4,18 @@ namespace alvio {
 
 FrontEnd::FrontEnd(const Config& config)
     : camera_(CameraModel::create(config.camera)),
+      exposure_(config.points.exposure_jump),
       point_tracker_(config.points, camera_),
       line_tracker_(config.estimator.use_lines ? createLineTracker(config.camera, config.lines)
                                                : nullptr) {}
 
 FeatureFrame FrontEnd::track(const cv::Mat& gray, int64_t t_ns, FrameTiming* timing) {
-  FeatureFrame frame = point_tracker_.track(gray, t_ns, timing);
+  const double mean = cv::mean(gray)[0];
+  const cv::Mat& image = exposure_.apply(gray, mean, &compensated_);
+  FeatureFrame frame = point_tracker_.track(image, t_ns, timing);
+  frame.mean_intensity = mean;  // the scene's light, not the compensated level
   if (line_tracker_) {
-    LineFrame lines = line_tracker_->track(gray, t_ns * 1e-9);
+    LineFrame lines = line_tracker_->track(image, t_ns * 1e-9);
     frame.lines = std::move(lines.lines);
     frame.line_stats = lines.stats;
     if (timing) {

@@ -10,6 +10,7 @@
 #include "alvio/camera/camera_model.h"
 #include "alvio/common/timing.h"
 #include "alvio/config/config.h"
+#include "alvio/frontend/exposure_compensation.h"
 #include "alvio/frontend/feature_frame.h"
 #include "alvio/frontend/point_tracker.h"
 #include "alvio/lines/line_tracker.h"
@@ -33,6 +34,8 @@ class FrontEnd {
 
  private:
   std::shared_ptr<const CameraModel> camera_;
+  ExposureCompensation exposure_;
+  cv::Mat compensated_;
   PointTracker point_tracker_;
   std::unique_ptr<LineTracker> line_tracker_;  // null when lines are off
 };
