@@ -80,7 +80,7 @@ NodeletConfig::NodeletConfig(const ros::NodeHandle& nh, const ros::NodeHandle& p
     throw alvio::Error("parameter '" + file_param + "' is empty: set it to a YAML configuration");
   std::string text;
   try {
-    text = alvio::readTextFile(file_);
+    text = alvio::readConfigText(file_);
   } catch (const alvio::Error& e) {
     throw alvio::Error(std::string(e.what()) + " (parameter '" +
                        (file_param.empty() ? "config_file" : file_param) + "')");

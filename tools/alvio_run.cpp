@@ -45,7 +45,7 @@ int main(int argc, char** argv) {
     // The configuration file with the --set overrides laid over it; the reader keeps the
     // file's path, so relative paths in it still resolve next to the file.
     const std::string config_path = args.get("config");
-    std::string config_text = readTextFile(config_path);
+    std::string config_text = readConfigText(config_path);
     std::vector<std::string> override_keys;
     if (args.isSet("set")) {
       std::stringstream list(args.get("set"));

@@ -135,3 +135,45 @@ TEST(Config, EurocSensorYamlIsReadable) {
   EXPECT_DOUBLE_EQ(imu->gyroscope_noise_density, c.imu.gyroscope_noise_density);
   EXPECT_DOUBLE_EQ(imu->accelerometer_random_walk, c.imu.accelerometer_random_walk);
 }
+
+// --- base: a configuration that overrides another ------------------------------------------
+
+TEST(ConfigBase, OverridesTheBaseKeyByKeyAndInheritsTheRest) {
+  const std::string dir = test::scratchDir();
+  writeFile(dir, "robot.yaml", eurocYaml());
+  const std::string child = writeFile(dir, "child.yaml",
+                                      "base: robot.yaml\n"
+                                      "estimator:\n  window_size: 7\n"
+                                      "  imu_noise:\n    accelerometer_noise_density: 0.08\n");
+  const Config base = Config::load(dir + "/robot.yaml");
+  const Config c = Config::load(child);
+  EXPECT_EQ(c.estimator.window_size, 7);
+  EXPECT_DOUBLE_EQ(c.estimator.imu_noise.accelerometer_noise_density, 0.08);
+  EXPECT_DOUBLE_EQ(c.estimator.imu_noise.gyroscope_noise_density, 0.0);  // the sensor's
+  EXPECT_EQ(c.estimator.max_iterations, base.estimator.max_iterations);
+  EXPECT_EQ(c.camera.width, base.camera.width);
+  EXPECT_DOUBLE_EQ(c.imu.accelerometer_noise_density, base.imu.accelerometer_noise_density);
+  EXPECT_EQ(c.source, child);
+}
+
+TEST(ConfigBase, MissingBaseAndCyclesNameTheFile) {
+  const std::string dir = test::scratchDir();
+  const std::string orphan = writeFile(dir, "orphan.yaml", "base: nowhere.yaml\n");
+  expectErrorMentioning([&] { Config::load(orphan); }, {"orphan.yaml", "'base'", "nowhere.yaml"});
+  writeFile(dir, "a.yaml", "base: b.yaml\n");
+  const std::string b = writeFile(dir, "b.yaml", "base: a.yaml\n");
+  expectErrorMentioning([&] { Config::load(b); }, {"'base'", "cycle"});
+  const std::string bad = writeFile(dir, "bad.yaml", "base: [1, 2]\n");
+  expectErrorMentioning([&] { Config::load(bad); }, {"bad.yaml", "'base' must name"});
+}
+
+TEST(ConfigBase, ShippedRealImuConfigIsEurocWithInFlightImuNoise) {
+  const Config euroc = Config::load(test::sourcePath("config/euroc.yaml"));
+  const Config real = Config::load(test::sourcePath("config/euroc_real.yaml"));
+  EXPECT_DOUBLE_EQ(real.estimator.imu_noise.accelerometer_noise_density, 0.08);
+  EXPECT_DOUBLE_EQ(real.estimator.imu_noise.gyroscope_random_walk, 2.0e-6);
+  // The sensor block (what the simulator uses) is euroc.yaml's.
+  EXPECT_DOUBLE_EQ(real.imu.accelerometer_noise_density, euroc.imu.accelerometer_noise_density);
+  EXPECT_EQ(real.estimator.window_size, euroc.estimator.window_size);
+  EXPECT_DOUBLE_EQ(euroc.estimator.imu_noise.accelerometer_noise_density, 0.0);
+}

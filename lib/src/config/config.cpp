@@ -3,12 +3,13 @@
 #include <cstdlib>
 
 #include "alvio/common/resource_path.h"
+#include "alvio/config/yaml_overlay.h"
 #include "alvio/config/yaml_reader.h"
 
 namespace alvio {
 
 Config Config::load(const std::string& path) {
-  return load(YamlReader(path));
+  return load(YamlReader::fromString(readConfigText(path), path));
 }
 
 Config Config::load(const YamlReader& yaml) {

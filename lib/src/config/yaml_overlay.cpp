@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -83,6 +84,34 @@ std::string readTextFile(const std::string& path) {
   std::ostringstream buffer;
   buffer << in.rdbuf();
   return buffer.str();
+}
+
+namespace {
+std::string readConfigText(const std::string& path, int depth) {
+  const std::string text = readTextFile(path);
+  YAML::Node root = parse(text, path);
+  if (!root.IsMap() || !root["base"]) return text;
+  const YAML::Node base = root["base"];
+  if (!base.IsScalar() || base.as<std::string>().empty())
+    throw Error(path + ": key 'base' must name a configuration file");
+  if (depth >= 8) throw Error(path + ": key 'base': more than 8 files deep (a cycle?)");
+  std::filesystem::path base_path = base.as<std::string>();
+  if (base_path.is_relative()) base_path = std::filesystem::path(path).parent_path() / base_path;
+  std::string base_text;
+  try {
+    base_text = readConfigText(base_path.string(), depth + 1);
+  } catch (const Error& e) {
+    throw Error(path + ": key 'base': " + e.what());
+  }
+  root.remove("base");
+  YAML::Emitter out;
+  out << root;
+  return overlayYaml(base_text, base_path.string(), out.c_str(), path);
+}
+}  // namespace
+
+std::string readConfigText(const std::string& path) {
+  return readConfigText(path, 0);
 }
 
 std::string assignmentToYaml(const std::string& assignment) {

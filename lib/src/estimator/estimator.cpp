@@ -29,11 +29,16 @@ Estimator::~Estimator() = default;
 
 ImuNoise Estimator::imuNoise() const {
   const double s = options_.imu_noise_scale;
+  const auto& o = options_.imu_noise;
+  const auto pick = [s](double override_value, double sensor) {
+    return s * (override_value > 0 ? override_value : sensor);
+  };
   ImuNoise n;
-  n.acc_noise_density = s * imu_options_.accelerometer_noise_density;
-  n.gyr_noise_density = s * imu_options_.gyroscope_noise_density;
-  n.acc_random_walk = s * imu_options_.accelerometer_random_walk;
-  n.gyr_random_walk = s * imu_options_.gyroscope_random_walk;
+  n.acc_noise_density =
+      pick(o.accelerometer_noise_density, imu_options_.accelerometer_noise_density);
+  n.gyr_noise_density = pick(o.gyroscope_noise_density, imu_options_.gyroscope_noise_density);
+  n.acc_random_walk = pick(o.accelerometer_random_walk, imu_options_.accelerometer_random_walk);
+  n.gyr_random_walk = pick(o.gyroscope_random_walk, imu_options_.gyroscope_random_walk);
   return n;
 }
 

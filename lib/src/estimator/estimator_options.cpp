@@ -1,5 +1,7 @@
 #include "alvio/estimator/estimator_options.h"
 
+#include <utility>
+
 #include "alvio/common/error.h"
 #include "alvio/config/yaml_reader.h"
 
@@ -18,6 +20,15 @@ EstimatorOptions EstimatorOptions::load(const YamlReader& yaml, const std::strin
   o.outlier_reprojection_px =
       yaml.getDouble(p + "outlier_reprojection_px", o.outlier_reprojection_px);
   o.imu_noise_scale = yaml.getDouble(p + "imu_noise_scale", o.imu_noise_scale);
+  for (auto [key, value] : {std::pair{"accelerometer_noise_density",
+                                      &o.imu_noise.accelerometer_noise_density},
+                            {"gyroscope_noise_density", &o.imu_noise.gyroscope_noise_density},
+                            {"accelerometer_random_walk", &o.imu_noise.accelerometer_random_walk},
+                            {"gyroscope_random_walk", &o.imu_noise.gyroscope_random_walk}}) {
+    const std::string k = p + "imu_noise." + key;
+    *value = yaml.getDouble(k, *value);
+    if (*value < 0) throw Error(yaml.where(k) + " must not be negative (0: the sensor's value)");
+  }
   o.use_lines = yaml.getBool(p + "use_lines", o.use_lines);
   o.record_analysis = yaml.getBool(p + "record_analysis", o.record_analysis);
   o.line_sigma_px = yaml.getDouble(p + "line_sigma_px", o.line_sigma_px);

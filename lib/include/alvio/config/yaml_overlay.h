@@ -26,4 +26,10 @@ std::string assignmentToYaml(const std::string& assignment);
 /// The contents of a text file; throws alvio::Error naming it when it cannot be read.
 std::string readTextFile(const std::string& path);
 
+/// A configuration file's text with its `base:` resolved: a file may name another
+/// configuration (a path relative to its own folder) whose keys it overrides one by one, so
+/// that a robot's or a sensor's file holds only what differs. Bases may have bases. Throws
+/// alvio::Error naming the file and key on a missing base or a cycle.
+std::string readConfigText(const std::string& path);
+
 }  // namespace alvio

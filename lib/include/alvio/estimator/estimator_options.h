@@ -20,6 +20,13 @@ struct EstimatorOptions {
   double robust_loss_scale = 1.0;      ///< in units of sigma
   double outlier_reprojection_px = 3.0;  ///< landmarks with a larger mean error are removed
   double imu_noise_scale = 1.0;          ///< multiplies every IMU noise density and random walk
+  /// The IMU noise the preintegration is weighted with, when it is not the sensor's
+  /// datasheet noise of `imu:` (a real IMU in flight: rotor vibration; see
+  /// config/euroc_real.yaml). Keys estimator.imu_noise.*; each <= 0: the sensor's value.
+  struct ImuNoiseOverride {
+    double accelerometer_noise_density = 0, gyroscope_noise_density = 0;
+    double accelerometer_random_walk = 0, gyroscope_random_walk = 0;
+  } imu_noise;
 
   bool record_analysis = false;  ///< keep WindowTrackRecords (alvio run --analysis)
 
