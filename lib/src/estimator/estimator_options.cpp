@@ -20,11 +20,11 @@ EstimatorOptions EstimatorOptions::load(const YamlReader& yaml, const std::strin
   o.outlier_reprojection_px =
       yaml.getDouble(p + "outlier_reprojection_px", o.outlier_reprojection_px);
   o.imu_noise_scale = yaml.getDouble(p + "imu_noise_scale", o.imu_noise_scale);
-  for (auto [key, value] : {std::pair{"accelerometer_noise_density",
-                                      &o.imu_noise.accelerometer_noise_density},
-                            {"gyroscope_noise_density", &o.imu_noise.gyroscope_noise_density},
-                            {"accelerometer_random_walk", &o.imu_noise.accelerometer_random_walk},
-                            {"gyroscope_random_walk", &o.imu_noise.gyroscope_random_walk}}) {
+  for (auto [key, value] :
+       {std::pair{"accelerometer_noise_density", &o.imu_noise.accelerometer_noise_density},
+        {"gyroscope_noise_density", &o.imu_noise.gyroscope_noise_density},
+        {"accelerometer_random_walk", &o.imu_noise.accelerometer_random_walk},
+        {"gyroscope_random_walk", &o.imu_noise.gyroscope_random_walk}}) {
     const std::string k = p + "imu_noise." + key;
     *value = yaml.getDouble(k, *value);
     if (*value < 0) throw Error(yaml.where(k) + " must not be negative (0: the sensor's value)");
