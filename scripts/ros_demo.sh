@@ -67,21 +67,14 @@ else
   fi
 fi
 
-# A private master on a free port, so that runs never collide with another roscore.
-port=$(python3 -c 'import socket; s = socket.socket(); s.bind(("", 0)); print(s.getsockname()[1])')
-export ROS_MASTER_URI="http://localhost:$port"
 run="$out/run"
 rm -rf "$run"
 mkdir -p "$run"
-export ROS_LOG_DIR="$out/ros_log"
-roscore -p "$port" >"$out/roscore.log" 2>&1 &
-core_pid=$!
-trap 'kill "$core_pid" 2>/dev/null || true; wait "$core_pid" 2>/dev/null || true' EXIT
-for _ in $(seq 100); do
-  rosparam get /rosdistro >/dev/null 2>&1 && break
-  sleep 0.2
-done
-rosparam get /rosdistro >/dev/null 2>&1 || die "roscore did not start (see $out/roscore.log)"
+# shellcheck source=lib/private_master.sh
+source "$ROOT/scripts/lib/private_master.sh"
+core_pid=""
+trap 'kill $core_pid 2>/dev/null || true; wait 2>/dev/null || true' EXIT
+start_private_master "$out" || die "roscore did not start (see $out/roscore.log)"
 
 if $record_status; then
   rosbag record --quiet -O "$run/status.bag" /alvio/estimator/status __name:=status_recorder \

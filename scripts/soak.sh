@@ -42,14 +42,11 @@ source "$BUILD/devel/setup.bash"
 set -u
 
 mkdir -p "$out"
-port=$(python3 -c 'import socket; s = socket.socket(); s.bind(("", 0)); print(s.getsockname()[1])')
-export ROS_MASTER_URI="http://localhost:$port"
-export ROS_LOG_DIR="$out/ros_log"
-roscore -p "$port" >"$out/roscore.log" 2>&1 &
-core_pid=$!
-trap 'kill "$core_pid" 2>/dev/null || true; wait "$core_pid" 2>/dev/null || true' EXIT
-for _ in $(seq 100); do rosparam get /rosdistro >/dev/null 2>&1 && break; sleep 0.2; done
-rosparam get /rosdistro >/dev/null 2>&1 || die "roscore did not start (see $out/roscore.log)"
+# shellcheck source=lib/private_master.sh
+source "$ROOT/scripts/lib/private_master.sh"
+core_pid=""
+trap 'kill $core_pid 2>/dev/null || true; wait 2>/dev/null || true' EXIT
+start_private_master "$out" || die "roscore did not start (see $out/roscore.log)"
 
 log "looping $(basename "$bag") at rate $rate for $minutes min (master $ROS_MASTER_URI)"
 roslaunch alvio sim.launch bag:="$bag" rate:="$rate" loop:=true output_dir:="$out/run" \
@@ -80,6 +77,9 @@ while (($(date +%s) < end)); do
   echo "$line" >>"$out/soak.csv"
   log "$line"
 done
+# While tracking, so that the current run has poses to write (a run the loop has just
+# restarted has none yet, and an empty trajectory is not written).
+for _ in $(seq 20); do [[ $(status_field state) == *tracking* ]] && break; sleep 2; done
 log "SIGTERM to the nodelet manager ($pid0)"
 rm -f "$out/run/"{trajectory.tum,octomap.bt,lines.csv,lines.ply,map.3Dscene}  # only what SIGTERM writes counts
 kill -TERM "$pid0"
