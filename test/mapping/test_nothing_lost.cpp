@@ -69,6 +69,18 @@ int waitExitCode(pid_t pid) {
   return WIFEXITED(status) ? WEXITSTATUS(status) : 1000 + WTERMSIG(status);
 }
 
+// Every map and log file in `out` loads with its own library; returns whether the rawlog
+// did (into *rawlog), so a caller that reads it on can stop when it did not.
+bool expectSavedFilesLoad(const std::string& out, mrpt::obs::CRawlog* rawlog) {
+  EXPECT_NO_THROW(readOctomapBinary(out + "/octomap.bt"));
+  EXPECT_NO_THROW(readLinesCsv(out + "/lines.csv"));
+  for (const char* scene : {"map.3Dscene", "alvio.3Dscene"}) {
+    mrpt::opengl::COpenGLScene s;
+    EXPECT_TRUE(s.loadFromFile(out + "/" + scene)) << scene;
+  }
+  return rawlog->loadFromRawLogFile(out + "/alvio.rawlog");
+}
+
 std::string microDataset() {
   const std::string shared = test::sharedDataDir();
   const std::string data = shared + "/euroc_V1_01_easy_micro_kimera";
@@ -87,14 +99,8 @@ void expectCompleteOutputs(const std::string& out) {
   const std::string timing = readFile(out + "/timing.csv");
   EXPECT_EQ(static_cast<std::size_t>(std::count(timing.begin(), timing.end(), '\n')), frames + 1);
   EXPECT_EQ(readFile(out + "/trajectory.tum").rfind("# timestamp", 0), 0u);
-  EXPECT_NO_THROW(readOctomapBinary(out + "/octomap.bt"));
-  EXPECT_NO_THROW(readLinesCsv(out + "/lines.csv"));
-  for (const char* scene : {"map.3Dscene", "alvio.3Dscene"}) {
-    mrpt::opengl::COpenGLScene s;
-    EXPECT_TRUE(s.loadFromFile(out + "/" + scene)) << scene;
-  }
   mrpt::obs::CRawlog rawlog;
-  ASSERT_TRUE(rawlog.loadFromRawLogFile(out + "/alvio.rawlog"));
+  ASSERT_TRUE(expectSavedFilesLoad(out, &rawlog));
   std::size_t imu = 0;
   for (std::size_t i = 0; i < rawlog.size(); ++i)
     imu += rawlog.getType(i) == mrpt::obs::CRawlog::etObservation &&
@@ -256,16 +262,11 @@ TEST(NothingLost, SigkillDuringRunSaveKeepsPreviousMaps) {
     }
     // The logger finishes (renaming its rawlog) before the map is saved: either rawlog
     // is complete, and a leftover part means the old one is untouched.
-    if (fs::exists(out + "/alvio.rawlog.part"))
+    if (fs::exists(out + "/alvio.rawlog.part")) {
       EXPECT_EQ(readFile(out + "/alvio.rawlog"), rawlog_before);
-    EXPECT_NO_THROW(readOctomapBinary(out + "/octomap.bt"));
-    EXPECT_NO_THROW(readLinesCsv(out + "/lines.csv"));
-    for (const char* scene : {"map.3Dscene", "alvio.3Dscene"}) {
-      mrpt::opengl::COpenGLScene s;
-      EXPECT_TRUE(s.loadFromFile(out + "/" + scene)) << scene;
     }
     mrpt::obs::CRawlog rawlog;
-    EXPECT_TRUE(rawlog.loadFromRawLogFile(out + "/alvio.rawlog"));
+    EXPECT_TRUE(expectSavedFilesLoad(out, &rawlog));
   }
   EXPECT_TRUE(killed_mid_save) << "no run was caught during a save";
 }

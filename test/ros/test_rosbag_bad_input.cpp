@@ -16,6 +16,7 @@
 #include "test_support.h"
 
 using namespace alvio;
+using test::errorOf;
 namespace fs = std::filesystem;
 
 namespace {
@@ -53,16 +54,6 @@ std::string writeBag(const std::string& path, int frames, bool with_imu = true,
   }
   bag.close();
   return path;
-}
-
-std::string errorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "expected alvio::Error";
-  return "";
 }
 
 std::size_t readAll(RosbagSource& source) {

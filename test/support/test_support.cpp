@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <set>
 
+#include "alvio/common/error.h"
+
 namespace fs = std::filesystem;
 
 namespace alvio::test {
@@ -29,6 +31,16 @@ std::string scratchDir() {
 
 std::string sourcePath(const std::string& relative) {
   return (fs::path(ALVIO_SOURCE_DIR) / relative).string();
+}
+
+std::string errorOf(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "expected alvio::Error";
+  return "";
 }
 
 }  // namespace alvio::test

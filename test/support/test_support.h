@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <functional>
 #include <string>
 
 namespace alvio::test {
@@ -15,6 +16,8 @@ std::string sharedDataDir();
 std::string scratchDir();
 /// Path of a file inside the source tree.
 std::string sourcePath(const std::string& relative);
+/// The message of the alvio::Error that `f` throws ("" and a test failure when it throws none).
+std::string errorOf(const std::function<void()>& f);
 
 }  // namespace alvio::test
 

@@ -19,6 +19,7 @@
 #include "test_support.h"
 
 using namespace alvio;
+using test::errorOf;
 namespace fs = std::filesystem;
 
 namespace {
@@ -31,18 +32,6 @@ std::string readFile(const std::string& path) {
 std::string writeFile(const std::string& path, const std::string& text) {
   std::ofstream(path, std::ios::binary) << text;
   return path;
-}
-
-// The message of the alvio::Error thrown by f ("" and a test failure when none is).
-template <typename F>
-std::string errorOf(F&& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "expected alvio::Error";
-  return "";
 }
 
 #define EXPECT_MENTIONS(message, fragment)               \

@@ -9,21 +9,13 @@
 #include "test_support.h"
 
 using namespace alvio;
+using test::errorOf;
 
 namespace {
 std::string writeFile(const std::string& name, const std::string& text) {
   const std::string path = test::scratchDir() + "/" + name;
   std::ofstream(path) << text;
   return path;
-}
-
-std::string errorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
 }
 }  // namespace
 
