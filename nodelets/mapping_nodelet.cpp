@@ -36,7 +36,7 @@ class MappingNodelet : public GuardedNodelet {
     ros::NodeHandle& nh = getNodeHandle();
     ros::NodeHandle& pnh = getPrivateNodeHandle();
     const NodeletConfig config(nh, pnh);
-    const alvio::MappingOptions options = alvio::MappingOptions::load(config.yaml(), "mapping");
+    options_ = alvio::MappingOptions::load(config.yaml(), "mapping");
     config.rejectUnusedOverrides();
     output_dir_ = param(pnh, "output_dir", "");
     world_frame_ = param(pnh, "world_frame", "world");
@@ -46,9 +46,7 @@ class MappingNodelet : public GuardedNodelet {
     const std::string odometry_topic = param(pnh, "odometry_topic", "estimator/odometry");
     requireParam(period > 0, pnh, "publish_period", "must be positive");
     requireParam(!world_frame_.empty(), pnh, "world_frame", "is empty");
-    max_line_std_deg_ = options.max_line_direction_std_deg;
-    options_ = options;
-    map_ = std::make_unique<alvio::MapBuilder>(options);
+    map_ = std::make_unique<alvio::MapBuilder>(options_);
 
     lines_pub_ = pnh.advertise<visualization_msgs::MarkerArray>("lines", 1, true);
     occupied_pub_ = pnh.advertise<sensor_msgs::PointCloud2>("occupied", 1, true);
@@ -57,7 +55,7 @@ class MappingNodelet : public GuardedNodelet {
     odometry_sub_ = nh.subscribe(odometry_topic, 200, &MappingNodelet::onOdometry, this);
     timer_ = pnh.createTimer(ros::Duration(period), &MappingNodelet::onTimer, this);
     NODELET_INFO("mapping %s with %s (OctoMap %.3f m); %s", keyframes_sub_.getTopic().c_str(),
-                 config.describe().c_str(), options.octomap.resolution,
+                 config.describe().c_str(), options_.octomap.resolution,
                  output_dir_.empty() ? "output_dir is not set: the map is saved nowhere"
                                      : ("saving into " + output_dir_).c_str());
   }
@@ -65,7 +63,7 @@ class MappingNodelet : public GuardedNodelet {
   void onKeyframe(const alvio::MapKeyframe::ConstPtr& msg) {
     std::lock_guard<std::mutex> lock(mutex_);
     startNewRunIfTimeJumpedBack(msg->header.stamp);
-    map_->addKeyframe(fromMsg(*msg, max_line_std_deg_));
+    map_->addKeyframe(fromMsg(*msg, options_.max_line_direction_std_deg));
     changed_since_publish_ = changed_since_save_ = true;
   }
 
@@ -147,7 +145,6 @@ class MappingNodelet : public GuardedNodelet {
   int64_t newest_ns_ = 0;  // newest keyframe or odometry stamp
   std::string output_dir_, world_frame_, last_error_;
   bool save_on_shutdown_ = true, changed_since_publish_ = false, changed_since_save_ = false;
-  double max_line_std_deg_ = 2.0;
   ros::Publisher lines_pub_, occupied_pub_;
   ros::ServiceServer save_srv_;
   ros::Subscriber keyframes_sub_, odometry_sub_;

@@ -79,7 +79,8 @@ void PointTracker::rejectWithFundamental(std::vector<cv::Point2f>* prev,
   keep(counts, status);
 }
 
-FeatureFrame PointTracker::track(const cv::Mat& gray, int64_t t_ns, FrameTiming* timing) {
+FeatureFrame PointTracker::track(const cv::Mat& gray, int64_t t_ns, FrameTiming* timing,
+                                 double mean_intensity) {
   if (gray.type() != CV_8UC1)
     throw Error("point tracker: expected an 8-bit single-channel image, got type " +
                 std::to_string(gray.type()));
@@ -89,7 +90,7 @@ FeatureFrame PointTracker::track(const cv::Mat& gray, int64_t t_ns, FrameTiming*
                 std::to_string(camera_->width()) + "x" + std::to_string(camera_->height()));
   FeatureFrame frame;
   frame.t_ns = t_ns;
-  frame.mean_intensity = cv::mean(gray)[0];
+  frame.mean_intensity = mean_intensity >= 0 ? mean_intensity : cv::mean(gray)[0];
 
   cv::Mat img;
   {

@@ -12,8 +12,8 @@ FrontEnd::FrontEnd(const Config& config)
 FeatureFrame FrontEnd::track(const cv::Mat& gray, int64_t t_ns, FrameTiming* timing) {
   const double mean = cv::mean(gray)[0];
   const cv::Mat& image = exposure_.apply(gray, mean, &compensated_);
-  FeatureFrame frame = point_tracker_.track(image, t_ns, timing);
-  frame.mean_intensity = mean;  // the scene's light, not the compensated level
+  // The frame records the scene's light, not the compensated level.
+  FeatureFrame frame = point_tracker_.track(image, t_ns, timing, mean);
   if (line_tracker_) {
     LineFrame lines = line_tracker_->track(image, t_ns * 1e-9);
     frame.lines = std::move(lines.lines);

@@ -39,7 +39,10 @@ class PointTracker {
   PointTracker(const PointTrackerOptions& options, std::shared_ptr<const CameraModel> camera);
 
   /// Track into the next 8-bit grey image. Stage times go to `timing` when given.
-  FeatureFrame track(const cv::Mat& gray, int64_t t_ns, FrameTiming* timing = nullptr);
+  /// `mean_intensity`: the scene's mean brightness when the caller has measured it (before
+  /// exposure compensation); negative: measured here, on `gray`.
+  FeatureFrame track(const cv::Mat& gray, int64_t t_ns, FrameTiming* timing = nullptr,
+                     double mean_intensity = -1);
   /// Forget all tracks (after a reset, or an image-size change).
   void reset();
   /// The preprocessed (equalised) image of the last frame, shared with the line front end.
