@@ -17,6 +17,7 @@ spin inserted. Results: OUT/faults.md and OUT/faults.json; each run's files stay
 OUT/<fault>/<mode>/.
 """
 import argparse
+import copy
 import json
 import math
 import os
@@ -60,6 +61,7 @@ class FaultContext:
     rng: random.Random = field(default_factory=lambda: random.Random(11))
     held: list = field(default_factory=list)
     count: int = 0
+    duration: object = None  # seconds -> rospy.Duration (rospy comes with the ROS environment)
 
     def inside(self, t):
         return self.t_fault <= t < self.t_end
@@ -113,16 +115,15 @@ def imu_out_of_order(ctx, topic, msg, t):
 def imu_duplicates(ctx, topic, msg, t):
     if topic != IMU_TOPIC or not ctx.inside(stamp_s(msg)):
         return [(topic, msg, t)]
-    import copy
     twin = copy.deepcopy(msg)
     twin.linear_acceleration.x += 0.05  # same stamp, different reading
-    return [(topic, msg, t), (topic, twin, t + ctx.rospy_duration(1e-6))]
+    return [(topic, msg, t), (topic, twin, t + ctx.duration(1e-6))]
 
 
 def time_jump_back(seconds):
     def mutate(ctx, topic, msg, t):
         if stamp_s(msg) >= ctx.t_fault:
-            msg.header.stamp = msg.header.stamp - ctx.rospy_duration(seconds)
+            msg.header.stamp = msg.header.stamp - ctx.duration(seconds)
         return [(topic, msg, t)]
     return mutate
 
@@ -295,8 +296,7 @@ def write_faulted_bag(clean, fault, t_fault, path):
     import rosbag  # from the sourced ROS environment
     import rospy
     t_end = t_fault + fault.duration
-    ctx = FaultContext(t_fault, t_end)
-    ctx.rospy_duration = lambda s: rospy.Duration.from_sec(s)
+    ctx = FaultContext(t_fault, t_end, duration=rospy.Duration.from_sec)
     with rosbag.Bag(str(clean)) as src, rosbag.Bag(str(path) + ".tmp", "w") as dst:
         for topic, msg, t in src.read_messages(topics=[IMAGE_TOPIC, IMU_TOPIC]):
             for o_topic, o_msg, o_t in fault.mutate(ctx, topic, msg, t):
@@ -347,7 +347,7 @@ def evaluate(bin_dir, env, gt, traj_path, fault, t_fault, run_dir):
     return res
 
 
-def run_offline(args, env, bag, fault, run_dir, timeout):
+def run_offline(args, env, bag, run_dir, timeout):
     bin_dir = Path(args.build) / "devel/lib/alvio"
     cmd = [str(bin_dir / "alvio_run"), "--dataset", str(bag), "--out", str(run_dir),
            "--quiet"]
@@ -377,7 +377,7 @@ def read_statuses(path):
     return out
 
 
-def run_nodelet(args, env, bag, fault, run_dir, timeout):
+def run_nodelet(args, env, bag, run_dir, timeout):
     cmd = ["bash", str(ROOT / "scripts/ros_demo.sh"), "--bag", str(bag), "--out", str(run_dir),
            "--rate", str(args.rate), "--record-status"]
     with open(run_dir / "demo.log", "w") as logf:
@@ -481,10 +481,10 @@ def main():
             run_dir.mkdir()
             seconds = t1 - t0
             if mode == "offline":
-                res = run_offline(args, env, bag, fault, run_dir, timeout=60 + 10 * seconds)
+                res = run_offline(args, env, bag, run_dir, timeout=60 + 10 * seconds)
                 traj = run_dir / "trajectory.tum"
             else:
-                res = run_nodelet(args, env, bag, fault, run_dir,
+                res = run_nodelet(args, env, bag, run_dir,
                                   timeout=120 + 3 * seconds / args.rate)
                 traj = run_dir / "run/trajectory.tum"
             if res.get("completed"):

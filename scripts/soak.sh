@@ -32,18 +32,12 @@ done
 log() { printf '\033[1m[alvio soak]\033[0m %s\n' "$*" >&2; }
 die() { printf '[alvio soak] error: %s\n' "$*" >&2; exit 1; }
 
-export PATH="/usr/bin:/bin:/usr/sbin:/sbin:$PATH"
-unset AMENT_PREFIX_PATH PYTHONPATH || true
-[[ -f $BUILD/devel/setup.bash ]] || die "not built: run ./alvio build (or set ALVIO_BUILD_DIR)"
+# shellcheck source=lib/ros_env.sh
+source "$ROOT/scripts/lib/ros_env.sh"
+source_ros_build "$BUILD"
 [[ -f $bag ]] || die "no bag '$bag' (./alvio demo writes out/demo/demo.bag)"
-set +u
-# shellcheck disable=SC1091
-source "$BUILD/devel/setup.bash"
-set -u
 
 mkdir -p "$out"
-# shellcheck source=lib/private_master.sh
-source "$ROOT/scripts/lib/private_master.sh"
 core_pid=""
 trap 'kill $core_pid 2>/dev/null || true; wait 2>/dev/null || true' EXIT
 start_private_master "$out" || die "roscore did not start (see $out/roscore.log)"
