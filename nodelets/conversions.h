@@ -23,10 +23,6 @@
 
 namespace alvio_ros {
 
-/// Stamps going back by more than this (a bag played again, a restarted simulation) start a
-/// new run in every nodelet; smaller steps back are single bad messages, dropped.
-constexpr int64_t kNewRunJumpBackNs = 1'000'000'000;
-
 ros::Time toRosTime(int64_t t_ns);
 inline int64_t toNs(const ros::Time& t) {
   return static_cast<int64_t>(t.toNSec());

@@ -25,6 +25,7 @@
 #include <mutex>
 #include <thread>
 
+#include "alvio/common/clock_jump.h"
 #include "alvio/common/error.h"
 #include "alvio/estimator/estimator.h"
 #include "alvio/io/trajectory_io.h"
@@ -148,11 +149,14 @@ class EstimatorNodelet : public GuardedNodelet {
     {
       std::lock_guard<std::mutex> lock(mutex_);
       const int64_t t_ns = toNs(msg->features.header.stamp);
-      if (newest_ns_ != 0 && t_ns > newest_ns_ + kNewRunJumpBackNs) {
-        // Tracked before the time jump that restarted the run: not part of the new run.
-        NODELET_WARN_THROTTLE(2.0, "frame at %.3f s is over 1 s ahead of the IMU: dropped",
-                              t_ns * 1e-9);
-        return;
+      if (frames_of_old_clock_) {
+        if (alvio::clockJumpedBack(newest_ns_, t_ns)) {
+          // Tracked before the clock jump that restarted the run: not part of the new run.
+          NODELET_WARN_THROTTLE(2.0, "frame at %.3f s is from before the clock jump: dropped",
+                                t_ns * 1e-9);
+          return;
+        }
+        frames_of_old_clock_ = false;
       }
       const auto before = sync_.counts();
       sync_.addFrame(t_ns, msg);
@@ -170,21 +174,29 @@ class EstimatorNodelet : public GuardedNodelet {
     wake_.notify_one();
   }
 
-  // IMU time going back by more than a second (a bag played again, a restarted simulation)
+  // The IMU clock going back (a bag played again, a restarted simulation, a clock reset)
   // starts a new run: the queues are emptied now, the estimator restarted by the worker.
   // The IMU decides, as it comes straight from the sensor; frames lag behind the tracker.
   // Called under mutex_.
   void jumpedBack(int64_t t_ns) {
-    if (newest_ns_ != 0 && t_ns + kNewRunJumpBackNs < newest_ns_) {
+    if (alvio::clockJumpedBack(t_ns, newest_ns_)) {
+      NODELET_WARN("IMU clock jumped back %.2f s: the estimator starts a new run",
+                   (newest_ns_ - t_ns) * 1e-9);
       sync_ = Sync(sync_.options());
       restart_ = true;
+      frames_of_old_clock_ = true;
       newest_ns_ = t_ns;
     }
     newest_ns_ = std::max(newest_ns_, t_ns);
   }
 
+  // The finished run's trajectory is kept as trajectory_run<N>.tum; trajectory.tum and the
+  // path hold the new run's.
   void restart() {
-    NODELET_WARN("time jumped back: the estimator starts a new run (trajectory and path too)");
+    ++finished_runs_;
+    writeTrajectory("trajectory_run" + std::to_string(finished_runs_) + ".tum");
+    earlier_resets_ += estimator_->resetCount() + 1;
+    restarted_ = true;
     estimator_ = std::make_unique<alvio::Estimator>(config_.estimator, config_.camera, config_.imu);
     feed_ = std::make_unique<alvio::EstimatorKeyframeFeed>(config_.camera.T_b_c);
     trajectory_.clear();
@@ -254,11 +266,14 @@ class EstimatorNodelet : public GuardedNodelet {
     for (const auto& e : events) last_event_ = e.message;
     auto status = boost::make_shared<alvio::PipelineStatus>();
     status->header = header;
-    status->state = estimator_->resetCount() != resets_before ? alvio::PipelineStatus::RESET
-                    : has_pose                                ? alvio::PipelineStatus::TRACKING
-                                                              : alvio::PipelineStatus::INITIALISING;
+    const bool reset = restarted_ || estimator_->resetCount() != resets_before;
+    restarted_ = false;
+    status->state = reset      ? alvio::PipelineStatus::RESET
+                    : has_pose ? alvio::PipelineStatus::TRACKING
+                               : alvio::PipelineStatus::INITIALISING;
     status->message = last_event_;
-    status->reset_count = estimator_->resetCount();
+    // A new run after a clock jump counts as a reset too.
+    status->reset_count = earlier_resets_ + estimator_->resetCount();
     status->frames = frames_;
     status->dropped_frames = static_cast<uint32_t>(dropped_frames_);
     status->dropped_imu = static_cast<uint32_t>(dropped_imu_ + estimator_->droppedImu());
@@ -377,11 +392,11 @@ class EstimatorNodelet : public GuardedNodelet {
           flush_after_s_, keyframes.size());
   }
 
-  void writeTrajectory() {
+  void writeTrajectory(const std::string& name = "trajectory.tum") {
     if (output_dir_.empty() || trajectory_.empty()) return;
     try {
       std::filesystem::create_directories(output_dir_);
-      const std::string path = output_dir_ + "/trajectory.tum";
+      const std::string path = output_dir_ + "/" + name;
       alvio::writeTumTrajectory(path, trajectory_);
       NODELET_INFO("%zu poses written to %s", trajectory_.size(), path.c_str());
     } catch (const std::exception& e) {
@@ -403,13 +418,16 @@ class EstimatorNodelet : public GuardedNodelet {
   std::condition_variable wake_;
   Sync sync_;
   bool stop_ = false, restart_ = false;
-  int64_t newest_ns_ = 0;  // newest IMU stamp
+  bool frames_of_old_clock_ = false;  // after a clock jump, until a frame on the new clock
+  int64_t newest_ns_ = 0;             // newest IMU stamp
 
   // The worker's.
   std::thread worker_;
   std::unique_ptr<alvio::Estimator> estimator_;
   std::unique_ptr<alvio::EstimatorKeyframeFeed> feed_;
   alvio::Trajectory trajectory_;
+  int finished_runs_ = 0, earlier_resets_ = 0;
+  bool restarted_ = false;  // the next status reports the new run as a reset
   nav_msgs::Path path_;
   Eigen::Vector3d last_gyr_ = Eigen::Vector3d::Zero();
   std::string last_event_;

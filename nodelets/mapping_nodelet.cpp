@@ -14,6 +14,7 @@
 #include <memory>
 #include <mutex>
 
+#include "alvio/common/clock_jump.h"
 #include "alvio/common/error.h"
 #include "alvio/mapping/map_builder.h"
 #include "alvio/mapping/occupancy_map.h"
@@ -81,8 +82,8 @@ class MappingNodelet : public GuardedNodelet {
   // estimator's trajectory, what is saved is the latest run's. Called under mutex_.
   void startNewRunIfTimeJumpedBack(const ros::Time& stamp) {
     const int64_t t_ns = toNs(stamp);
-    if (newest_ns_ != 0 && t_ns + kNewRunJumpBackNs < newest_ns_) {
-      NODELET_WARN("time jumped back %.1f s: the map starts afresh (new run)",
+    if (alvio::clockJumpedBack(t_ns, newest_ns_)) {
+      NODELET_WARN("clock jumped back %.2f s: the map starts afresh (new run)",
                    (newest_ns_ - t_ns) * 1e-9);
       map_ = std::make_unique<alvio::MapBuilder>(options_);
       newest_ns_ = t_ns;

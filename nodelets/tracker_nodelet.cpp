@@ -12,6 +12,7 @@
 
 #include <memory>
 
+#include "alvio/common/clock_jump.h"
 #include "alvio/common/error.h"
 #include "alvio/pipeline/front_end.h"
 #include "conversions.h"
@@ -76,9 +77,9 @@ class TrackerNodelet : public GuardedNodelet {
       return;
     }
     const int64_t t_ns = toNs(image->header.stamp);
-    if (last_t_ns_ != 0 && t_ns + kNewRunJumpBackNs < last_t_ns_) {
-      // A bag played again, or a restarted simulation: a new run.
-      NODELET_WARN("time jumped back %.1f s: the front end starts afresh",
+    if (alvio::clockJumpedBack(t_ns, last_t_ns_)) {
+      // A bag played again, a restarted simulation, a clock reset: a new run.
+      NODELET_WARN("image clock jumped back %.2f s: the front end starts afresh",
                    (last_t_ns_ - t_ns) * 1e-9);
       front_end_ = std::make_unique<alvio::FrontEnd>(config_);
       last_t_ns_ = 0;

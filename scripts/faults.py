@@ -322,14 +322,27 @@ def ate(bin_dir, env, gt, rows, path):
     return json.loads(js.read_text())["ate_translation_m"]["rmse"]
 
 
+def read_runs(traj_path):
+    """The poses in the order they were estimated: first the runs that a clock jump ended
+    (the nodelets keep each as trajectory_run<N>.tum), then the current one."""
+    runs = sorted(traj_path.parent.glob("trajectory_run*.tum"),
+                  key=lambda p: int(p.stem[len("trajectory_run"):]))
+    return np.vstack([read_tum(p) for p in runs] + [read_tum(traj_path)])
+
+
 def evaluate(bin_dir, env, gt, traj_path, fault, t_fault, run_dir):
-    rows = read_tum(traj_path)
+    rows = read_runs(traj_path)
     res = {"poses": int(len(rows)), "nan_poses": int((~np.isfinite(rows)).any(axis=1).sum())}
     rows = rows[np.isfinite(rows).all(axis=1)]
     if fault.shift_after_s and len(rows):
         rows = rows.copy()
-        # Every stamp after the jump lies past the last one before it (older ones are dropped).
-        rows[rows[:, 0] >= t_fault, 0] -= fault.shift_after_s
+        # Back onto the true clock. The old clock's stamps all lie before the fault, so in
+        # estimation order the new clock starts at the first stamp that is past the fault or
+        # goes back.
+        t = rows[:, 0]
+        new_clock = (t >= t_fault) | np.concatenate([[False], np.diff(t) < 0])
+        first = int(np.argmax(new_clock)) if new_clock.any() else len(rows)
+        rows[first:, 0] -= fault.shift_after_s
     before, after = rows[rows[:, 0] < t_fault], rows[rows[:, 0] >= t_fault]
     res["ate_before_m"] = ate(bin_dir, env, gt, before, run_dir / "eval_before.tum")
     res["ate_after_m"] = ate(bin_dir, env, gt, after, run_dir / "eval_after.tum")

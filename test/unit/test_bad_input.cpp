@@ -350,6 +350,24 @@ TEST(BadStream, NonFiniteAndOutOfOrderMessagesAreDroppedAndCounted) {
   EXPECT_EQ(summary["dropped_images"], 2);
 }
 
+TEST(BadStream, ClockJumpBackResetsAndContinuesOnTheNewClock) {
+  const int64_t t0 = 1'000'000'000'000, imu_dt = 5'000'000, back = 500'000'000;
+  std::vector<SensorMessage> messages;
+  for (int i = 0; i <= 400; ++i) {  // 2 s; from 1 s on every stamp is 0.5 s earlier
+    const int64_t t = t0 + i * imu_dt - (i >= 200 ? back : 0);
+    if (i % 10 == 0) messages.push_back(imageAt(t));
+    messages.push_back(imuAt(t));
+  }
+  ListSource source(messages);
+  const std::string out = test::scratchDir() + "/out";
+  const RunResult r = runOffline(source, defaultConfig(), quietRun(out));
+  EXPECT_EQ(r.resets, 1);
+  EXPECT_EQ(r.frames, 41u) << "every image, on either clock, is tracked";
+  EXPECT_EQ(r.dropped_images, 0u);
+  EXPECT_EQ(r.dropped_imu, 0u);
+  EXPECT_NE(readFile(out + "/events.log").find("IMU clock jumped back 0.495 s"), std::string::npos);
+}
+
 TEST(LogThrottle, OneLinePerPeriodCountingWhatItStandsFor) {
   LogThrottle throttle(2.0);
   std::size_t n = 0;

@@ -1,7 +1,9 @@
 #include "alvio/estimator/estimator.h"
 
 #include <cmath>
+#include <cstdio>
 
+#include "alvio/common/clock_jump.h"
 #include "alvio/common/error.h"
 #include "alvio/common/logging.h"
 #include "alvio/common/rotation.h"
@@ -88,6 +90,17 @@ std::vector<EstimatorEvent> Estimator::takeEvents() {
 
 void Estimator::addImu(const ImuSample& s) {
   std::size_t n = 0;
+  if (clockJumpedBack(s.t_ns, last_queued_imu_ns_) && s.acc.allFinite() && s.gyr.allFinite()) {
+    // The window and the queued IMU belong to the old clock: start again on the new one.
+    char why[64];
+    std::snprintf(why, sizeof(why), "IMU clock jumped back %.3f s",
+                  (last_queued_imu_ns_ - s.t_ns) * 1e-9);
+    reset(s.t(), why);
+    imu_queue_.clear();
+    has_imu_ = false;
+    last_queued_imu_ns_ = 0;
+    ++clock_jumps_;
+  }
   if (has_imu_ || !imu_queue_.empty()) {
     if (s.t_ns <= last_queued_imu_ns_) {
       if (imu_late_.shouldLog(s.t_ns * 1e-9, &n))

@@ -1,5 +1,6 @@
 #include "alvio/pipeline/offline_runner.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <deque>
@@ -7,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "alvio/common/clock_jump.h"
 #include "alvio/common/error.h"
 #include "alvio/common/logging.h"
 #include "alvio/common/progress_bar.h"
@@ -165,10 +167,19 @@ RunResult runOffline(SensorSource& source, const Config& config, const RunOption
 
   const auto stopRequested = [&] { return options.stop && options.stop->load(); };
   SensorMessage m;
-  std::size_t images_seen = 0;
+  std::size_t images_seen = 0, images_of_old_clock = 0;
   while (!stopRequested() && source.next(&m)) {
     if (m.kind == SensorMessage::Kind::kImu) {
+      const int clock_jumps = pipeline.estimator().clockJumps();
       pipeline.addImu(m.imu);
+      if (pipeline.estimator().clockJumps() != clock_jumps) {
+        // Images of the old clock still waiting for IMU: none will come after them.
+        const auto old_clock = [&](const SensorMessage& p) {
+          return clockJumpedBack(m.t_ns, p.t_ns);
+        };
+        images_of_old_clock += std::count_if(pending.begin(), pending.end(), old_clock);
+        pending.erase(std::remove_if(pending.begin(), pending.end(), old_clock), pending.end());
+      }
       notify([&](RunObserver& o) { o.onImu(m.imu); });
       while (!pending.empty() && pending.front().t_ns < m.t_ns && !stopRequested()) {
         processImage(pending.front());
@@ -191,7 +202,7 @@ RunResult runOffline(SensorSource& source, const Config& config, const RunOption
                       : "");
   if (result.interrupted) logWarn("run stopped early: writing the results so far");
   result.resets = pipeline.estimator().resetCount();
-  result.dropped_images = pipeline.droppedImages();
+  result.dropped_images = pipeline.droppedImages() + images_of_old_clock;
   result.dropped_imu = pipeline.estimator().droppedImu();
   result.poses = result.trajectory.size();
 

@@ -9,6 +9,15 @@ VioPipeline::VioPipeline(const Config& config)
       front_end_(config),
       estimator_(config.estimator, config.camera, config.imu) {}
 
+void VioPipeline::addImu(const ImuSample& sample) {
+  const int jumps_before = estimator_.clockJumps();
+  estimator_.addImu(sample);
+  if (estimator_.clockJumps() != jumps_before) {
+    last_image_ns_ = 0;  // the next image starts the new clock
+    front_end_.resetPoints();
+  }
+}
+
 PipelineOutput VioPipeline::addImage(const cv::Mat& gray, int64_t t_ns) {
   PipelineOutput out;
   out.timing.t = t_ns * 1e-9;

@@ -98,6 +98,8 @@ class Estimator {
   ~Estimator();
 
   /// Queue an IMU sample (time-ordered; older or duplicate stamps are dropped with a warning).
+  /// A stamp over kClockJumpBackNs before the newest is a clock jump: the estimator resets
+  /// and continues on the new clock (clockJumps() counts them).
   void addImu(const ImuSample& sample);
   /// Process a frame. IMU up to its time (and one sample after, for interpolation) should be
   /// queued. Returns true when the frame has a pose estimate (after initialisation).
@@ -117,6 +119,8 @@ class Estimator {
   /// with the final poses of every frame that saw it (for maps). Output frame.
   LineSegments3 takeRetiredLines();
   int resetCount() const { return reset_count_; }
+  /// IMU clock jumps back seen by addImu (each also counted as a reset).
+  int clockJumps() const { return clock_jumps_; }
   /// IMU samples dropped by addImu: not after the previous one, or not finite.
   std::size_t droppedImu() const { return imu_late_.total() + imu_nonfinite_.total(); }
   /// Window records since the last call (only when options.record_analysis).
@@ -231,6 +235,7 @@ class Estimator {
   BodyState dead_reckoned_;
   BodyState last_output_;
   int reset_count_ = 0;
+  int clock_jumps_ = 0;
   double init_scale_ = 0;
   bool bias_prior_pending_ = false;  // the initialisation bias prior is not yet marginalised
   Eigen::Vector3d bias_prior_bg_ = Eigen::Vector3d::Zero();
