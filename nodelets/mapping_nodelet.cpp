@@ -29,7 +29,7 @@ class MappingNodelet : public GuardedNodelet {
  public:
   ~MappingNodelet() override {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (map_ && save_on_shutdown_ && !output_dir_.empty() && changed_since_save_) save();
+    if (map_ && save_on_shutdown_ && !output_dir_.empty() && changed_since_save_) save(output_dir_);
   }
 
  private:
@@ -79,12 +79,15 @@ class MappingNodelet : public GuardedNodelet {
 
   // The estimator starts a new run, in a new world frame, when time jumps back (a bag played
   // again): so does the map, as a map mixing two frames is worth nothing. Like the
-  // estimator's trajectory, what is saved is the latest run's. Called under mutex_.
+  // estimator's trajectory (trajectory_run<N>.tum), the finished run's map is kept, in
+  // run<N>/. Called under mutex_.
   void startNewRunIfTimeJumpedBack(const ros::Time& stamp) {
     const int64_t t_ns = toNs(stamp);
     if (alvio::clockJumpedBack(t_ns, newest_ns_)) {
       NODELET_WARN("clock jumped back %.2f s: the map starts afresh (new run)",
                    (newest_ns_ - t_ns) * 1e-9);
+      ++finished_runs_;
+      if (!output_dir_.empty()) save(output_dir_ + "/run" + std::to_string(finished_runs_));
       map_ = std::make_unique<alvio::MapBuilder>(options_);
       newest_ns_ = t_ns;
       changed_since_publish_ = changed_since_save_ = true;
@@ -119,18 +122,17 @@ class MappingNodelet : public GuardedNodelet {
                          " is not set: nowhere to save the map";
       return true;
     }
-    response.success = save();
+    response.success = save(output_dir_);
     response.message = response.success ? "map saved into " + output_dir_ : last_error_;
     return true;
   }
 
   // MapBuilder::save writes every file atomically (temp file, then rename).
-  bool save() {
+  bool save(const std::string& dir) {
     try {
-      map_->save(output_dir_);
+      map_->save(dir);
       changed_since_save_ = false;
-      NODELET_INFO("map saved into %s:\n%s", output_dir_.c_str(),
-                   map_->summary().toString().c_str());
+      NODELET_INFO("map saved into %s:\n%s", dir.c_str(), map_->summary().toString().c_str());
       return true;
     } catch (const std::exception& e) {
       last_error_ = std::string("cannot save the map: ") + e.what();
@@ -144,6 +146,7 @@ class MappingNodelet : public GuardedNodelet {
   alvio::MappingOptions options_;
   std::unique_ptr<alvio::MapBuilder> map_;
   int64_t newest_ns_ = 0;  // newest keyframe or odometry stamp
+  int finished_runs_ = 0;
   std::string output_dir_, world_frame_, last_error_;
   bool save_on_shutdown_ = true, changed_since_publish_ = false, changed_since_save_ = false;
   ros::Publisher lines_pub_, occupied_pub_;

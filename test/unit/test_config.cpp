@@ -89,6 +89,15 @@ TEST(Config, NegativeNoiseIsRejected) {
   expectErrorMentioning([&] { Config::load(path); }, {"accelerometer_random_walk", "positive"});
 }
 
+TEST(Config, NegativeSettlingIsRejected) {
+  const std::string dir = test::scratchDir();
+  const std::string path =
+      writeFile(dir, "settle.yaml",
+                eurocYamlReplacing("init_settle_change: 0.003", "init_settle_change: -1"));
+  expectErrorMentioning([&] { Config::load(path); },
+                        {"estimator.init_settle_change", "must not be negative"});
+}
+
 TEST(Config, NonRotationExtrinsicIsRejected) {
   const std::string dir = test::scratchDir();
   const std::string path = writeFile(dir, "rot.yaml", eurocYamlReplacing("0.0148655429818", "2.0"));

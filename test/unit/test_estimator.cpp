@@ -101,6 +101,31 @@ TEST(Estimator, IsDeterministic) {
   }
 }
 
+// After alignment the estimator holds its output until the scale settles: the first pose is
+// the one of the kInitialized event, at most init_settle_max_s after the alignment (which is
+// when the output starts with settling off).
+TEST(Estimator, HoldsOutputUntilTheScaleSettles) {
+  Config settling = Config::load(test::sourcePath("config/euroc.yaml"));
+  ASSERT_GT(settling.estimator.init_settle_max_s, 0);
+  Config at_once = settling;
+  at_once.estimator.init_settle_max_s = 0;
+  test::ScenarioOptions so;
+  so.duration_s = 8;
+  const test::SyntheticScenario scenario(so, settling.camera, settling.imu);
+  const RunOutcome a = runEstimator(scenario, at_once), s = runEstimator(scenario, settling);
+  ASSERT_TRUE(a.init && s.init);
+  ASSERT_FALSE(a.trajectory.empty());
+  ASSERT_FALSE(s.trajectory.empty());
+  const double start = nsToSec(test::SyntheticScenario::kStartNs);
+  EXPECT_NEAR(a.trajectory.front().t - start, a.init->time, 1e-9);
+  EXPECT_NEAR(s.trajectory.front().t - start, s.init->time, 1e-9);
+  EXPECT_GE(s.init->time, a.init->time);
+  EXPECT_LE(s.init->time, a.init->time + settling.estimator.init_settle_max_s + 0.051);
+  EXPECT_LT(s.init->scale_error, 0.05);
+  std::cout << "initialised at " << a.init->time << " s (scale error " << a.init->scale_error
+            << "), settled at " << s.init->time << " s (" << s.init->scale_error << ")\n";
+}
+
 // Losing every feature resets the estimator; it re-initialises and the output
 // continues from the IMU-dead-reckoned pose (no jump to a new world frame).
 TEST(Estimator, ResetsOnTrackingLossAndKeepsOutputContinuous) {

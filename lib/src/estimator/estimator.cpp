@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include "alvio/common/clock_jump.h"
 #include "alvio/common/error.h"
@@ -72,6 +73,8 @@ void Estimator::clearState() {
   first_moving_attempt_ = -1;
   last_wait_reason_.clear();
   bias_prior_pending_ = false;
+  settling_ = false;
+  settling_positions_.clear();
 }
 
 void Estimator::event(EstimatorEvent::Kind kind, double t, const std::string& message) {
@@ -247,13 +250,12 @@ bool Estimator::addFrame(const FeatureFrame& frame, FrameTiming* timing) {
       for (auto& b : Bgs_) b = bg.allFinite() ? bg : Eigen::Vector3d::Zero();
       return false;
     }
-    EstimatorEvent e;
-    e.kind = EstimatorEvent::Kind::kInitialized;
-    e.t = t;
-    e.window = windowStates();
-    e.scale = init_scale_;
-    e.message = "initialised";
-    events_.push_back(std::move(e));
+    settling_ = options_.init_settle_max_s > 0;
+    settle_start_ = t;
+    if (!settling_)
+      initialized(t);
+    else
+      rememberSettlingWindow();
     {
       ScopedStage stage(timing, "marginalization");
       marginalize();
@@ -262,6 +264,7 @@ bool Estimator::addFrame(const FeatureFrame& frame, FrameTiming* timing) {
     points_.removeFailures();
     last_R_ = Rs_[W_];
     last_P_ = Ps_[W_];
+    if (settling_) return false;
   } else {
     const int tracked = points_.lastTrackedCount() + lines_.lastTrackedCount();
     if (tracked < options_.min_tracked_features) {
@@ -275,6 +278,15 @@ bool Estimator::addFrame(const FeatureFrame& frame, FrameTiming* timing) {
       reset(t, why);
       return false;
     }
+    if (settling_) {
+      if (windowScaleChange() <= options_.init_settle_change ||
+          t - settle_start_ >= options_.init_settle_max_s) {
+        settling_ = false;
+        initialized(t);
+      } else {
+        rememberSettlingWindow();
+      }
+    }
     {
       ScopedStage stage(timing, "marginalization");
       marginalize();
@@ -283,6 +295,7 @@ bool Estimator::addFrame(const FeatureFrame& frame, FrameTiming* timing) {
     points_.removeFailures();
     last_R_ = Rs_[W_];
     last_P_ = Ps_[W_];
+    if (settling_) return false;
   }
   // Output continuity: after a reset, anchor the new world frame on the dead-reckoned pose.
   if (align_output_after_reset_) {
@@ -336,6 +349,37 @@ void Estimator::reset(double t, const std::string& why) {
   }
   align_output_after_reset_ = have_output_;
   event(EstimatorEvent::Kind::kReset, t, "reset: " + why);
+}
+
+void Estimator::initialized(double t) {
+  EstimatorEvent e;
+  e.kind = EstimatorEvent::Kind::kInitialized;
+  e.t = t;
+  e.window = windowStates();
+  e.scale = init_scale_;
+  e.message = "initialised";
+  events_.push_back(std::move(e));
+}
+
+void Estimator::rememberSettlingWindow() {
+  settling_positions_.clear();
+  for (int i = 0; i <= W_; ++i) settling_positions_[header_ns_[i]] = Ps_[i];
+}
+
+double Estimator::windowScaleChange() const {
+  // The distance between the oldest and the newest frame both optimisations hold.
+  int first = -1, last = -1;
+  for (int i = 0; i <= W_; ++i) {
+    if (!settling_positions_.count(header_ns_[i])) continue;
+    if (first < 0) first = i;
+    last = i;
+  }
+  if (first < 0 || last == first) return std::numeric_limits<double>::infinity();
+  const double before =
+      (settling_positions_.at(header_ns_[last]) - settling_positions_.at(header_ns_[first])).norm();
+  const double now = (Ps_[last] - Ps_[first]).norm();
+  if (before < 1e-3) return std::numeric_limits<double>::infinity();
+  return std::abs(now / before - 1);
 }
 
 void Estimator::slideWindow() {

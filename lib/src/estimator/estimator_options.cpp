@@ -44,6 +44,8 @@ EstimatorOptions EstimatorOptions::load(const YamlReader& yaml, const std::strin
       yaml.getInt(p + "init_min_correspondences", o.init_min_correspondences);
   o.init_retry_interval_s = yaml.getDouble(p + "init_retry_interval_s", o.init_retry_interval_s);
   o.init_max_accel_bias = yaml.getDouble(p + "init_max_accel_bias", o.init_max_accel_bias);
+  o.init_settle_change = yaml.getDouble(p + "init_settle_change", o.init_settle_change);
+  o.init_settle_max_s = yaml.getDouble(p + "init_settle_max_s", o.init_settle_max_s);
   o.init_min_excitation = yaml.getDouble(p + "init_min_excitation", o.init_min_excitation);
   o.init_accel_bias_sigma = yaml.getDouble(p + "init_accel_bias_sigma", o.init_accel_bias_sigma);
   o.init_gyro_bias_sigma = yaml.getDouble(p + "init_gyro_bias_sigma", o.init_gyro_bias_sigma);
@@ -55,6 +57,10 @@ EstimatorOptions EstimatorOptions::load(const YamlReader& yaml, const std::strin
   o.max_rotation_jump_deg = yaml.getDouble(p + "max_rotation_jump_deg", o.max_rotation_jump_deg);
   if (o.window_size < 4) throw Error(yaml.where(p + "window_size") + " must be at least 4");
   if (o.max_iterations < 1) throw Error(yaml.where(p + "max_iterations") + " must be at least 1");
+  if (o.init_settle_change < 0)
+    throw Error(yaml.where(p + "init_settle_change") + " must not be negative");
+  if (o.init_settle_max_s < 0)
+    throw Error(yaml.where(p + "init_settle_max_s") + " must not be negative");
   if (o.num_threads < 1) throw Error(yaml.where(p + "num_threads") + " must be at least 1");
   if (o.point_sigma_px <= 0) throw Error(yaml.where(p + "point_sigma_px") + " must be positive");
   if (o.line_sigma_px <= 0) throw Error(yaml.where(p + "line_sigma_px") + " must be positive");

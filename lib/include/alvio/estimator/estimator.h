@@ -105,7 +105,8 @@ class Estimator {
   /// queued. Returns true when the frame has a pose estimate (after initialisation).
   bool addFrame(const FeatureFrame& frame, FrameTiming* timing = nullptr);
 
-  EstimatorStatus status() const { return status_; }
+  /// Initialising until the scale has settled after alignment (see init_settle_change).
+  EstimatorStatus status() const { return settling_ ? EstimatorStatus::kInitializing : status_; }
   /// State of the newest frame, in the output world frame.
   BodyState latestState() const;
   /// Keyframe states of the window, oldest first, in the output world frame.
@@ -153,6 +154,10 @@ class Estimator {
   void slideWindow();
   bool detectFailure(std::string* why) const;
   void reset(double t, const std::string& why);
+  // Settling after initialisation (options_.init_settle_*).
+  void initialized(double t);  // the kInitialized event, with the window
+  void rememberSettlingWindow();
+  double windowScaleChange() const;  // since rememberSettlingWindow(), as a fraction
   BodyState toOutput(const BodyState& s) const;
   void event(EstimatorEvent::Kind kind, double t, const std::string& message);
   ImuNoise imuNoise() const;
@@ -237,7 +242,11 @@ class Estimator {
   int reset_count_ = 0;
   int clock_jumps_ = 0;
   double init_scale_ = 0;
-  bool bias_prior_pending_ = false;  // the initialisation bias prior is not yet marginalised
+  bool bias_prior_pending_ = false;
+  bool settling_ = false;  ///< initialised, no output until the scale settles
+  double settle_start_ = 0;
+  std::map<int64_t, Eigen::Vector3d> settling_positions_;  ///< by frame time
+  // the initialisation bias prior is not yet marginalised
   Eigen::Vector3d bias_prior_bg_ = Eigen::Vector3d::Zero();
   int last_iterations_ = 0, last_point_residuals_ = 0, last_line_residuals_ = 0;
   OptimizationStats stats_;

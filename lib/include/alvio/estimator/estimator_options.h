@@ -53,6 +53,10 @@ struct EstimatorOptions {
   double init_accel_bias_sigma = 0.2;  ///< bias prior at initialisation [m/s^2] (<= 0: none)
   double init_gyro_bias_sigma = 0.05;  ///< [rad/s]
   double init_max_accel_bias = 0.5;    ///< reject an initialisation that needs a larger bias
+  /// After alignment the window keeps being optimised, without output, until one frame moves
+  /// its scale by less than this fraction (a short burst of motion leaves the scale loose)...
+  double init_settle_change = 0.003;
+  double init_settle_max_s = 1.5;  ///< ...or for this long at most. 0: output at once.
 
   // Failure detection (reset and re-initialise).
   int min_tracked_features = 10;  ///< fewer points + lines tracked into a frame: reset
