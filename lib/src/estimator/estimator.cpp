@@ -256,15 +256,6 @@ bool Estimator::addFrame(const FeatureFrame& frame, FrameTiming* timing) {
       initialized(t);
     else
       rememberSettlingWindow();
-    {
-      ScopedStage stage(timing, "marginalization");
-      marginalize();
-    }
-    slideWindow();
-    points_.removeFailures();
-    last_R_ = Rs_[W_];
-    last_P_ = Ps_[W_];
-    if (settling_) return false;
   } else {
     const int tracked = points_.lastTrackedCount() + lines_.lastTrackedCount();
     if (tracked < options_.min_tracked_features) {
@@ -287,16 +278,16 @@ bool Estimator::addFrame(const FeatureFrame& frame, FrameTiming* timing) {
         rememberSettlingWindow();
       }
     }
-    {
-      ScopedStage stage(timing, "marginalization");
-      marginalize();
-    }
-    slideWindow();
-    points_.removeFailures();
-    last_R_ = Rs_[W_];
-    last_P_ = Ps_[W_];
-    if (settling_) return false;
   }
+  {
+    ScopedStage stage(timing, "marginalization");
+    marginalize();
+  }
+  slideWindow();
+  points_.removeFailures();
+  last_R_ = Rs_[W_];
+  last_P_ = Ps_[W_];
+  if (settling_) return false;
   // Output continuity: after a reset, anchor the new world frame on the dead-reckoned pose.
   if (align_output_after_reset_) {
     align_output_after_reset_ = false;
