@@ -63,7 +63,9 @@ class MappingNodelet : public GuardedNodelet {
 
   void onKeyframe(const alvio::MapKeyframe::ConstPtr& msg) {
     std::lock_guard<std::mutex> lock(mutex_);
-    startNewRunIfTimeJumpedBack(msg->header.stamp);
+    // Keyframes leave the estimator's window well after their frame's odometry, so only the
+    // odometry tells a clock jump; a keyframe far ahead of it is the old run's.
+    if (alvio::clockJumpedBack(newest_ns_, toNs(msg->header.stamp))) return;
     map_->addKeyframe(fromMsg(*msg, options_.max_line_direction_std_deg));
     changed_since_publish_ = changed_since_save_ = true;
   }
@@ -78,9 +80,9 @@ class MappingNodelet : public GuardedNodelet {
   }
 
   // The estimator starts a new run, in a new world frame, when time jumps back (a bag played
-  // again): so does the map, as a map mixing two frames is worth nothing. Like the
-  // estimator's trajectory (trajectory_run<N>.tum), the finished run's map is kept, in
-  // run<N>/. Called under mutex_.
+  // again): so does the map (on the odometry's stamps), as a map mixing two frames is worth
+  // nothing. Like the estimator's trajectory (trajectory_run<N>.tum), the finished run's map is
+  // kept, in run<N>/. Called under mutex_.
   void startNewRunIfTimeJumpedBack(const ros::Time& stamp) {
     const int64_t t_ns = toNs(stamp);
     if (alvio::clockJumpedBack(t_ns, newest_ns_)) {
@@ -145,7 +147,7 @@ class MappingNodelet : public GuardedNodelet {
   std::mutex mutex_;  // the timer, callbacks and service share one queue; the destructor not
   alvio::MappingOptions options_;
   std::unique_ptr<alvio::MapBuilder> map_;
-  int64_t newest_ns_ = 0;  // newest keyframe or odometry stamp
+  int64_t newest_ns_ = 0;  // newest odometry stamp
   int finished_runs_ = 0;
   std::string output_dir_, world_frame_, last_error_;
   bool save_on_shutdown_ = true, changed_since_publish_ = false, changed_since_save_ = false;

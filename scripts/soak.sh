@@ -98,7 +98,16 @@ print(f"RSS MB: first {rss[0]:.0f}, last {rss[-1]:.0f}, peak {max(rss):.0f}; "
       f"mean of the first third {sum(rss[:third]) / third:.0f}, "
       f"of the last third {sum(rss[-third:]) / third:.0f}")
 PY
-grep -c "the estimator starts a new run" "$out/roslaunch.log" | sed 's/^/runs restarted by the loop: /' || true
+new_runs=$(grep -c "the estimator starts a new run" "$out/roslaunch.log" || true)
+echo "runs restarted by the loop: $new_runs"
+# Each finished run is kept once: the estimator's trajectory and the mapping nodelet's map.
+kept_trajectories=$(find "$out/run" -maxdepth 1 -name 'trajectory_run*.tum' | wc -l)
+kept_maps=$(find "$out/run" -mindepth 1 -maxdepth 1 -type d -name 'run[0-9]*' | wc -l)
+echo "finished runs kept: $kept_trajectories trajectories, $kept_maps maps"
 ((restarts == 0)) || die "the nodelet manager restarted $restarts time(s)"
+# The mapping nodelet hears of a new run from its first odometry, after initialisation: the
+# run ended by SIGTERM may not have reached it (its map is then the top-level one).
+((kept_maps == new_runs || kept_maps + 1 == new_runs)) ||
+  die "$new_runs new runs but $kept_maps maps kept (run<N>/)"
 ((${#missing[@]} == 0)) || die "not written on SIGTERM: ${missing[*]}"
 echo "written on SIGTERM into $out/run: trajectory.tum ($(wc -l <"$out/run/trajectory.tum") lines), octomap.bt, lines.csv, lines.ply, map.3Dscene"

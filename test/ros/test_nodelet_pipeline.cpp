@@ -261,6 +261,10 @@ TEST(NodeletPipeline, NodeletsUnloadWritingTheirFilesAndReload) {
   for (const char* f : {"octomap.bt", "lines.csv", "lines.ply", "map.3Dscene", "alvio.rawlog",
                         "alvio.3Dscene", "alvio.log"})
     EXPECT_TRUE(writtenNow(out + "/" + f)) << f << " was not written into " << out;
+  // One play of the bag is one run: no finished run was set aside (a clock jump would).
+  EXPECT_FALSE(std::filesystem::exists(out + "/run1")) << "the mapping nodelet started a new run";
+  EXPECT_FALSE(std::filesystem::exists(out + "/trajectory_run1.tum"))
+      << "the estimator nodelet started a new run";
 
   for (const auto& [name, type] : nodelets) EXPECT_TRUE(load(name, type)) << name;
   for (const auto& [name, type] : nodelets) EXPECT_TRUE(listed(name)) << name;
