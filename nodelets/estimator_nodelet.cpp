@@ -196,7 +196,6 @@ class EstimatorNodelet : public GuardedNodelet {
     ++finished_runs_;
     writeTrajectory("trajectory_run" + std::to_string(finished_runs_) + ".tum");
     earlier_resets_ += estimator_->resetCount() + 1;
-    restarted_ = true;
     estimator_ = std::make_unique<alvio::Estimator>(config_.estimator, config_.camera, config_.imu);
     feed_ = std::make_unique<alvio::EstimatorKeyframeFeed>(config_.camera.T_b_c);
     trajectory_.clear();
@@ -266,8 +265,8 @@ class EstimatorNodelet : public GuardedNodelet {
     for (const auto& e : events) last_event_ = e.message;
     auto status = boost::make_shared<alvio::PipelineStatus>();
     status->header = header;
-    const bool reset = restarted_ || estimator_->resetCount() != resets_before;
-    restarted_ = false;
+    const bool first_frame_of_new_run = finished_runs_ > 0 && frames_ == 1;
+    const bool reset = first_frame_of_new_run || estimator_->resetCount() != resets_before;
     status->state = reset      ? alvio::PipelineStatus::RESET
                     : has_pose ? alvio::PipelineStatus::TRACKING
                                : alvio::PipelineStatus::INITIALISING;
@@ -427,7 +426,6 @@ class EstimatorNodelet : public GuardedNodelet {
   std::unique_ptr<alvio::EstimatorKeyframeFeed> feed_;
   alvio::Trajectory trajectory_;
   int finished_runs_ = 0, earlier_resets_ = 0;
-  bool restarted_ = false;  // the next status reports the new run as a reset
   nav_msgs::Path path_;
   Eigen::Vector3d last_gyr_ = Eigen::Vector3d::Zero();
   std::string last_event_;

@@ -68,9 +68,10 @@ bool Estimator::initialStructure(double t) {
   Eigen::Matrix3d R_ref_last;
   Eigen::Vector3d t_ref_last;
   // Parallax is measured after removing the pair's rotation: rotation alone gives parallax
-  // but no baseline, and the essential matrix of such a pair is unreliable. The rotation is
-  // the essential matrix's, not the gyroscope's: before initialisation the gyroscope bias is
-  // unknown, and a real one (0.08 rad/s on EuRoC MH_03) hides or fakes tens of pixels.
+  // but no baseline, and the essential matrix of such a pair is unreliable. Both the
+  // gyroscope's and the essential matrix's rotation are removed and the larger parallax
+  // counts: before initialisation the gyroscope bias is unknown, and a real one (0.08 rad/s
+  // on EuRoC MH_03) hides tens of pixels.
   // The relaxed threshold applies once the window has shown that much parallax for
   // init_relax_after_s without reaching the strict one (the clock starts at that sighting).
   const double relaxed_parallax =
@@ -84,24 +85,24 @@ bool Estimator::initialStructure(double t) {
   for (int i = 0; i < W_; ++i) {
     const auto corr = points_.correspondences(i, W_);
     if (static_cast<int>(corr.size()) < options_.init_min_correspondences) continue;
-    Eigen::Matrix3d R_i_w;
-    Eigen::Vector3d t_i_w;
-    if (!relativePoseFromEssential(corr, &R_i_w, &t_i_w)) continue;
+    // The pose of the first passing pair is the reference's; later pairs are not looked at.
+    if (!relativePoseFromEssential(corr, &R_ref_last, &t_ref_last)) continue;
     Eigen::Quaterniond q_bi_bw = Eigen::Quaterniond::Identity();
     for (int k = i + 1; k <= W_; ++k) q_bi_bw = q_bi_bw * preintegrations_[k]->deltaQ();
     const Eigen::Matrix3d R_gyro = R_b_c.transpose() * q_bi_bw.toRotationMatrix() * R_b_c;
-    double parallax_e = 0, parallax_g = 0;
-    for (const auto& [a, b] : corr) {
-      const Eigen::Vector3d be = R_i_w * b, bg = R_gyro * b;
-      parallax_e += (a.head<2>() - be.head<2>() / be.z()).norm();
-      parallax_g += (a.head<2>() - bg.head<2>() / bg.z()).norm();
-    }
-    const double parallax = std::max(parallax_e, parallax_g) / corr.size();
+    // Mean image distance after rotating the newest frame's rays by R_i_last.
+    const auto parallaxAfter = [&corr](const Eigen::Matrix3d& R_i_last) {
+      double sum = 0;
+      for (const auto& [a, b] : corr) {
+        const Eigen::Vector3d b_in_i = R_i_last * b;
+        sum += (a.head<2>() - b_in_i.head<2>() / b_in_i.z()).norm();
+      }
+      return sum / corr.size();
+    };
+    const double parallax = std::max(parallaxAfter(R_ref_last), parallaxAfter(R_gyro));
     if (parallax >= relaxed_parallax && first_moving_attempt_ < 0) first_moving_attempt_ = t;
     if (parallax < min_parallax) continue;
     ref = i;
-    R_ref_last = R_i_w;
-    t_ref_last = t_i_w;
     break;
   }
   if (ref < 0) {

@@ -170,9 +170,7 @@ RunResult runOffline(SensorSource& source, const Config& config, const RunOption
   std::size_t images_seen = 0, images_of_old_clock = 0;
   while (!stopRequested() && source.next(&m)) {
     if (m.kind == SensorMessage::Kind::kImu) {
-      const int clock_jumps = pipeline.estimator().clockJumps();
-      pipeline.addImu(m.imu);
-      if (pipeline.estimator().clockJumps() != clock_jumps) {
+      if (pipeline.addImu(m.imu)) {
         // Images of the old clock still waiting for IMU: none will come after them.
         const auto old_clock = [&](const SensorMessage& p) {
           return clockJumpedBack(m.t_ns, p.t_ns);

@@ -9,13 +9,13 @@ VioPipeline::VioPipeline(const Config& config)
       front_end_(config),
       estimator_(config.estimator, config.camera, config.imu) {}
 
-void VioPipeline::addImu(const ImuSample& sample) {
+bool VioPipeline::addImu(const ImuSample& sample) {
   const int jumps_before = estimator_.clockJumps();
   estimator_.addImu(sample);
-  if (estimator_.clockJumps() != jumps_before) {
-    last_image_ns_ = 0;  // the next image starts the new clock
-    front_end_.resetPoints();
-  }
+  if (estimator_.clockJumps() == jumps_before) return false;
+  last_image_ns_ = 0;  // the next image starts the new clock
+  front_end_.resetPoints();
+  return true;
 }
 
 PipelineOutput VioPipeline::addImage(const cv::Mat& gray, int64_t t_ns) {

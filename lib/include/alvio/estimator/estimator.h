@@ -242,12 +242,11 @@ class Estimator {
   int reset_count_ = 0;
   int clock_jumps_ = 0;
   double init_scale_ = 0;
-  bool bias_prior_pending_ = false;
+  bool bias_prior_pending_ = false;  // the initialisation bias prior is not yet marginalised
+  Eigen::Vector3d bias_prior_bg_ = Eigen::Vector3d::Zero();
   bool settling_ = false;  ///< initialised, no output until the scale settles
   double settle_start_ = 0;
   std::map<int64_t, Eigen::Vector3d> settling_positions_;  ///< by frame time
-  // the initialisation bias prior is not yet marginalised
-  Eigen::Vector3d bias_prior_bg_ = Eigen::Vector3d::Zero();
   int last_iterations_ = 0, last_point_residuals_ = 0, last_line_residuals_ = 0;
   OptimizationStats stats_;
   double point_scale_ = 1.0, line_scale_ = 1.0;  // residual scales from the adaptive weights

@@ -38,7 +38,8 @@ class VioPipeline {
 
   /// Queue one IMU sample. The IMU clock decides on clock jumps (it comes straight from the
   /// sensor): after one the estimator has reset and images continue on the new clock.
-  void addImu(const ImuSample& sample);
+  /// Returns true when this sample was such a jump.
+  bool addImu(const ImuSample& sample);
   /// Track and estimate one 8-bit grey image. IMU up to (and one sample beyond) its time
   /// should have been added. An image not after the previous one is dropped (a stamp
   /// going back would run the tracker and the IMU integration backwards).
