@@ -179,7 +179,7 @@ TEST(ConfigBase, MissingBaseAndCyclesNameTheFile) {
 TEST(ConfigBase, ShippedRealImuConfigIsEurocWithInFlightImuNoise) {
   const Config euroc = Config::load(test::sourcePath("config/euroc.yaml"));
   const Config real = Config::load(test::sourcePath("config/euroc_real.yaml"));
-  EXPECT_DOUBLE_EQ(real.estimator.imu_noise.accelerometer_noise_density, 0.08);
+  EXPECT_DOUBLE_EQ(real.estimator.imu_noise.accelerometer_noise_density, 0.06);
   EXPECT_DOUBLE_EQ(real.estimator.imu_noise.gyroscope_random_walk, 2.0e-6);
   // The sensor block (what the simulator uses) is euroc.yaml's.
   EXPECT_DOUBLE_EQ(real.imu.accelerometer_noise_density, euroc.imu.accelerometer_noise_density);
