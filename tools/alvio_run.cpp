@@ -36,9 +36,9 @@ int main(int argc, char** argv) {
   args.option("line-tracker", "flow (ALVIO optical flow) | descriptor (PL-VIO LBD baseline)");
   args.flag("quiet", "no progress bar");
   args.option("analysis", "write sensitivity-analysis records (CSV) into this folder");
-  args.option("set",
-              "override configuration keys: key=value[,key=value...] "
-              "(e.g. estimator.selection.points=true)");
+  args.listOption("set",
+                  "override configuration keys: key=value[,key=value...], may be repeated "
+                  "(e.g. estimator.selection.points=true)");
   args.flag("no-log", "no MRPT logs (rawlog, 3D scene, alvio.log); also config logger.enabled");
   try {
     if (!args.parse(argc, argv)) return 0;

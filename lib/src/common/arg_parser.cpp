@@ -18,6 +18,11 @@ void ArgParser::option(const std::string& name, const std::string& help,
   specs_[name] = {help, fallback, false, required};
 }
 
+void ArgParser::listOption(const std::string& name, const std::string& help) {
+  order_.push_back(name);
+  specs_[name] = {help, "", false, false, true};
+}
+
 void ArgParser::flag(const std::string& name, const std::string& help) {
   order_.push_back(name);
   specs_[name] = {help, "", true, false};
@@ -69,7 +74,12 @@ bool ArgParser::parse(int argc, char** argv) {
       if (i + 1 >= argc) throw Error(program_ + ": option '--" + name + "' needs a value");
       value = argv[++i];
     }
-    values_[name] = value;
+    // A repeated option replaces the earlier value, except a list option, which collects.
+    const auto previous = values_.find(name);
+    if (it->second.is_list && previous != values_.end())
+      previous->second += "," + value;
+    else
+      values_[name] = value;
   }
   for (const auto& [name, spec] : specs_)
     if (spec.required && !values_.count(name))

@@ -16,6 +16,8 @@ class ArgParser {
   /// Declare an option taking a value; `fallback` empty + required=true makes it mandatory.
   void option(const std::string& name, const std::string& help, const std::string& fallback = "",
               bool required = false);
+  /// Declare an option that may be given several times; get() joins the values with ','.
+  void listOption(const std::string& name, const std::string& help);
   /// Declare a boolean flag (no value).
   void flag(const std::string& name, const std::string& help);
 
@@ -32,7 +34,7 @@ class ArgParser {
  private:
   struct Spec {
     std::string help, fallback;
-    bool is_flag = false, required = false;
+    bool is_flag = false, required = false, is_list = false;
   };
   std::string program_, summary_;
   std::vector<std::string> order_;
