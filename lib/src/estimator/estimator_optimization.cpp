@@ -54,29 +54,37 @@ bool Estimator::lineSelected(const LineLandmark& l) const {
 void Estimator::updateWeights() {
   stats_ = OptimizationStats();
   double track_p = 0, track_l = 0;
+  int point_residuals = 0, line_residuals = 0;  // of the selected features, as optimize() adds
   for (const auto& [id, l] : points_.landmarks()) {
     if (!l.usable(W_)) continue;
     ++stats_.points_tracked;
     track_p += l.sightings.size();
-    stats_.points_used += pointSelected(l);
+    if (!pointSelected(l)) continue;
+    ++stats_.points_used;
+    point_residuals += static_cast<int>(l.sightings.size()) - 1;
   }
   for (const auto& [id, l] : lines_.landmarks()) {
     if (!options_.use_lines || !lines_.usable(l)) continue;
     ++stats_.lines_tracked;
     track_l += l.observations.size();
-    stats_.lines_used += lineSelected(l);
+    if (!lineSelected(l)) continue;
+    ++stats_.lines_used;
+    line_residuals += static_cast<int>(l.observations.size());
   }
   const double M_p = stats_.points_tracked ? track_p / stats_.points_tracked : 0;
   const double M_l = stats_.lines_tracked ? track_l / stats_.lines_tracked : 0;
-  const FeatureWeights w = adaptiveWeights(M_p, M_l, options_.selection);
+  const FeatureSelectionOptions& o = options_.selection;
+  const FeatureWeights w = adaptiveWeights(M_p, M_l, o);
   stats_.w_p = w.w_p;
   stats_.w_l = w.w_l;
   stats_.alpha = w.alpha;
   stats_.M_p = M_p;
   stats_.M_l = M_l;
-  // Residuals are scaled by 2w, so equal weights leave the visual terms unchanged.
-  point_scale_ = options_.selection.adaptive_weighting && options_.use_lines ? 2 * w.w_p : 1.0;
-  line_scale_ = options_.selection.adaptive_weighting && options_.use_lines ? 2 * w.w_l : 1.0;
+  ResidualScales scales;  // unweighted
+  if (o.adaptive_weighting && options_.use_lines)
+    scales = residualScales(w, point_residuals, line_residuals, o.normalize_weights);
+  point_scale_ = scales.points;
+  line_scale_ = scales.lines;
 }
 
 void Estimator::statesToParameters() {

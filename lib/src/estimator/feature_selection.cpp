@@ -48,6 +48,7 @@ FeatureSelectionOptions FeatureSelectionOptions::load(const YamlReader& yaml,
   o.alpha_similar = yaml.getDouble(p + "alpha_similar", o.alpha_similar);
   o.alpha_less = yaml.getDouble(p + "alpha_less", o.alpha_less);
   o.similar_band = yaml.getDouble(p + "similar_band", o.similar_band);
+  o.normalize_weights = yaml.getBool(p + "normalize_weights", o.normalize_weights);
   for (const char* k : {"alpha_more", "alpha_similar", "alpha_less"})
     if (yaml.getDouble(p + k, 1.0) <= 0) throw Error(yaml.where(p + k) + " must be positive");
   if (o.similar_band < 0) throw Error(yaml.where(p + "similar_band") + " must not be negative");
@@ -78,6 +79,18 @@ FeatureWeights adaptiveWeights(double M_p, double M_l, const FeatureSelectionOpt
   w.w_p = M_p / denominator;
   w.w_l = w.alpha * M_l / denominator;
   return w;
+}
+
+ResidualScales residualScales(const FeatureWeights& w, int point_residuals, int line_residuals,
+                              bool normalize) {
+  ResidualScales s{2 * w.w_p, 2 * w.w_l};
+  if (!normalize) return s;
+  // Information goes with the square of the scale: keep its sum over all visual residuals.
+  const double weighted =
+      s.points * s.points * point_residuals + s.lines * s.lines * line_residuals;
+  if (weighted <= 0) return ResidualScales();
+  const double k = std::sqrt((point_residuals + line_residuals) / weighted);
+  return {k * s.points, k * s.lines};
 }
 
 }  // namespace alvio

@@ -38,6 +38,10 @@ struct FeatureSelectionOptions {
   double alpha_similar = 2.2;  ///< about as long
   double alpha_less = 1.0;     ///< shorter
   double similar_band = 0.2;   ///< |M_l - M_p| <= band * max(M_l, M_p) counts as "about as long"
+  /// Scale the weighted residuals so that points and lines together carry as much
+  /// information as unweighted: the weights then move trust between points and lines, not
+  /// from the camera to the IMU. Off: residuals scaled by 2w (equal weights = unweighted).
+  bool normalize_weights = true;
 
   /// Reads `prefix` ("estimator.selection"); a relative surfaces_file is resolved against the
   /// directory of the config file and loaded (errors name that file and key).
@@ -54,5 +58,14 @@ struct FeatureWeights {
 
 /// The ALVIO weights for mean track counts M_p and M_l.
 FeatureWeights adaptiveWeights(double M_p, double M_l, const FeatureSelectionOptions& options);
+
+/// Factors that multiply the point and line residuals for weights `w`, with
+/// `point_residuals` and `line_residuals` residual blocks in the window (see
+/// FeatureSelectionOptions::normalize_weights).
+struct ResidualScales {
+  double points = 1.0, lines = 1.0;
+};
+ResidualScales residualScales(const FeatureWeights& w, int point_residuals, int line_residuals,
+                              bool normalize);
 
 }  // namespace alvio

@@ -1,0 +1,58 @@
+// Adaptive point/line weights (ALVIO Sec. 3) and the residual scales the estimator applies.
+#include <gtest/gtest.h>
+
+#include "alvio/estimator/feature_selection.h"
+
+using namespace alvio;
+
+TEST(AdaptiveWeights, AlphaFollowsWhichKindTracksLonger) {
+  const FeatureSelectionOptions o;                            // alpha 5.0 / 2.2 / 1.0, band 20 %
+  EXPECT_DOUBLE_EQ(adaptiveWeights(4.0, 8.0, o).alpha, 5.0);  // lines track longer
+  EXPECT_DOUBLE_EQ(adaptiveWeights(5.0, 4.5, o).alpha, 2.2);  // within the band
+  EXPECT_DOUBLE_EQ(adaptiveWeights(8.0, 4.0, o).alpha, 1.0);  // lines track shorter
+}
+
+TEST(AdaptiveWeights, AreThePapersFractionsAndSumToOne) {
+  const FeatureSelectionOptions o;
+  const FeatureWeights w = adaptiveWeights(6.0, 3.0, o);  // alpha 1
+  EXPECT_DOUBLE_EQ(w.w_p, 6.0 / 9.0);
+  EXPECT_DOUBLE_EQ(w.w_l, 3.0 / 9.0);
+  const FeatureWeights more = adaptiveWeights(3.0, 6.0, o);  // alpha 5
+  EXPECT_DOUBLE_EQ(more.w_l, 30.0 / 33.0);
+  EXPECT_DOUBLE_EQ(more.w_p + more.w_l, 1.0);
+}
+
+TEST(ResidualScales, EqualWeightsLeaveResidualsUnscaled) {
+  FeatureWeights equal;  // 0.5 / 0.5
+  for (bool normalize : {false, true}) {
+    const ResidualScales s = residualScales(equal, 1200, 300, normalize);
+    EXPECT_DOUBLE_EQ(s.points, 1.0);
+    EXPECT_DOUBLE_EQ(s.lines, 1.0);
+  }
+}
+
+TEST(ResidualScales, NormalizedKeepTheTotalVisualInformation) {
+  FeatureWeights w;
+  w.w_p = 0.3;
+  w.w_l = 0.7;
+  const int n_p = 1300, n_l = 280;
+  const ResidualScales raw = residualScales(w, n_p, n_l, false);
+  EXPECT_DOUBLE_EQ(raw.points, 0.6);
+  EXPECT_DOUBLE_EQ(raw.lines, 1.4);
+  const ResidualScales s = residualScales(w, n_p, n_l, true);
+  // Information is the square of the scale, summed over the residuals.
+  EXPECT_NEAR(s.points * s.points * n_p + s.lines * s.lines * n_l, n_p + n_l, 1e-9);
+  EXPECT_NEAR(s.lines / s.points, w.w_l / w.w_p, 1e-12);
+  // Without the normalisation these weights leave 64 % of it (0.36 * 1300 + 1.96 * 280).
+  EXPECT_NEAR((raw.points * raw.points * n_p + raw.lines * raw.lines * n_l) / (n_p + n_l), 0.6435,
+              1e-4);
+}
+
+TEST(ResidualScales, NoResidualsGiveUnitScales) {
+  FeatureWeights w;
+  w.w_p = 0.2;
+  w.w_l = 0.8;
+  const ResidualScales s = residualScales(w, 0, 0, true);
+  EXPECT_DOUBLE_EQ(s.points, 1.0);
+  EXPECT_DOUBLE_EQ(s.lines, 1.0);
+}
