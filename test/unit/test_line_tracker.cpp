@@ -89,6 +89,24 @@ TEST(LineDetector, KeepsLongSegmentsLongestFirstUpToTheCap) {
   for (std::size_t i = 0; i < 4; ++i) EXPECT_NEAR(capped[i].length(), lines[i].length(), 1e-9);
 }
 
+TEST(LineDetector, LargerLsdQuantSkipsFaintEdges) {
+  // Two vertical steps: a faint one (12 grey levels) at x = 250, a strong one (120) at x = 500.
+  cv::Mat image(kSize, CV_8UC1, cv::Scalar(60));
+  image.colRange(250, 500).setTo(72);
+  image.colRange(500, kSize.width).setTo(192);
+  const auto edgesAt = [&](double quant) {
+    LineDetectorOptions o;
+    o.lsd_quant = quant;
+    std::set<int> xs;
+    for (const LineSegment& s : LineDetector(o, kSize).detect(image))
+      if (std::abs(s.start.x() - s.end.x()) < 2 && s.length() > 200)
+        xs.insert(static_cast<int>(std::lround(s.midpoint().x() / 10) * 10));
+    return xs;
+  };
+  EXPECT_EQ(edgesAt(2.0), (std::set<int>{250, 500}));
+  EXPECT_EQ(edgesAt(8.0), (std::set<int>{500}));
+}
+
 TEST(LineTracker, TrackedLinesComeFirstUnderTheCap) {
   // With room for 6 lines, the second frame keeps the 6 tracked ones and starts none of the
   // new bar's longer edges.
@@ -334,13 +352,14 @@ TEST(LineTracker, DistortedStraightEdgeComesOutStraightInNormalisedCoordinates) 
 
 TEST(LineTrackerOptions, LoadFromYamlAndNameBadKeys) {
   const auto yaml = YamlReader::fromString(
-      "lines:\n  tracker: descriptor\n  detector: {max_lines: 25, lsd_scale: 0.8}\n"
+      "lines:\n  tracker: descriptor\n  detector: {max_lines: 25, lsd_scale: 0.8, lsd_quant: 4}\n"
       "  flow: {samples_per_line: 7}\n",
       "test.yaml");
   const LineTrackerOptions o = LineTrackerOptions::load(yaml, "lines");
   EXPECT_EQ(o.tracker, "descriptor");
   EXPECT_EQ(o.detector.max_lines, 25);
   EXPECT_DOUBLE_EQ(o.detector.lsd_scale, 0.8);
+  EXPECT_DOUBLE_EQ(o.detector.lsd_quant, 4.0);
   EXPECT_DOUBLE_EQ(o.detector.min_length_ratio, 0.06);
   EXPECT_EQ(o.flow.samples_per_line, 7);
   EXPECT_TRUE(yaml.unknownKeys().empty());
@@ -355,6 +374,8 @@ TEST(LineTrackerOptions, LoadFromYamlAndNameBadKeys) {
     EXPECT_NE(std::string(e.what()).find("lines.flow.klt_window_px"), std::string::npos)
         << e.what();
   }
+  const auto bad_quant = YamlReader::fromString("lines:\n  detector: {lsd_quant: 0}\n", "q.yaml");
+  EXPECT_THROW(LineTrackerOptions::load(bad_quant, "lines"), Error);
   const auto bad_tracker = YamlReader::fromString("lines:\n  tracker: magic\n", "t.yaml");
   EXPECT_THROW(LineTrackerOptions::load(bad_tracker, "lines"), Error);
 }

@@ -9,7 +9,7 @@ LineDetector::LineDetector(const LineDetectorOptions& options, cv::Size image_si
     : options_(options) {
   options_.validate("line detector");
   min_length_ = options_.min_length_ratio * std::hypot(image_size.width, image_size.height);
-  // OpenCV's defaults apart from the scale, sigma and refinement (quant 2, angle 22.5 deg,
+  // OpenCV's defaults apart from the scale, sigma, quant and refinement (angle 22.5 deg,
   // log_eps 0, density 0.7, 1024 bins).
   if (options_.method == "fld")
     // Segments shorter than any we keep are not worth FLD's fitting; no merging (the tracker
@@ -19,7 +19,7 @@ LineDetector::LineDetector(const LineDetectorOptions& options, cv::Size image_si
   else
     lsd_ = cv::createLineSegmentDetector(
         options_.lsd_refine ? cv::LSD_REFINE_STD : cv::LSD_REFINE_NONE, options_.lsd_scale,
-        options_.lsd_sigma_scale);
+        options_.lsd_sigma_scale, options_.lsd_quant);
 }
 
 std::vector<LineSegment> LineDetector::detect(const cv::Mat& gray, const cv::Mat& valid_mask) {

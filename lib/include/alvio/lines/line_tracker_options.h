@@ -36,6 +36,9 @@ struct LineDetectorOptions {
   double lsd_sigma_scale = 0.6;
   /// LSD_REFINE_STD (true: splits segments at bends) or LSD_REFINE_NONE.
   bool lsd_refine = false;
+  /// LSD's bound on the gradient's quantisation error (OpenCV's `quant`): pixels whose
+  /// gradient is under quant / sin(22.5 deg) grow no region. Larger skips faint edges.
+  double lsd_quant = 2.0;
   /// Segments must keep this distance [px] from the invalid (unmapped) border of the
   /// undistorted image.
   int border_margin_px = 2;
