@@ -84,7 +84,7 @@ class TrackerNodelet : public GuardedNodelet {
       front_end_ = std::make_unique<alvio::FrontEnd>(config_);
       last_t_ns_ = 0;
     }
-    if (last_t_ns_ != 0 && t_ns <= last_t_ns_) {
+    if (alvio::staleStamp(t_ns, last_t_ns_)) {
       NODELET_WARN_THROTTLE(5.0, "image stamps go back in time (%.3f s after %.3f s): skipped",
                             t_ns * 1e-9, last_t_ns_ * 1e-9);
       return;

@@ -1,5 +1,6 @@
 #include "alvio/pipeline/vio_pipeline.h"
 
+#include "alvio/common/clock_jump.h"
 #include "alvio/common/logging.h"
 
 namespace alvio {
@@ -21,7 +22,7 @@ bool VioPipeline::addImu(const ImuSample& sample) {
 PipelineOutput VioPipeline::addImage(const cv::Mat& gray, int64_t t_ns) {
   PipelineOutput out;
   out.timing.t = t_ns * 1e-9;
-  if (last_image_ns_ != 0 && t_ns <= last_image_ns_) {
+  if (staleStamp(t_ns, last_image_ns_)) {
     std::size_t n = 0;
     if (images_late_.shouldLog(t_ns * 1e-9, &n))
       logWarn(n, " image(s) not after the previous one dropped (latest at ", t_ns, " ns, previous ",

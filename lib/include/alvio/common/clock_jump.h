@@ -15,4 +15,10 @@ inline bool clockJumpedBack(int64_t t_ns, int64_t newest_ns) {
   return newest_ns != 0 && t_ns + kClockJumpBackNs < newest_ns;
 }
 
+/// True when `t_ns` is not after `newest_ns` (0: nothing yet): a repeated, late or reordered
+/// stamp that cannot follow the newest one. Test clockJumpedBack() first.
+inline bool staleStamp(int64_t t_ns, int64_t newest_ns) {
+  return newest_ns != 0 && t_ns <= newest_ns;
+}
+
 }  // namespace alvio
