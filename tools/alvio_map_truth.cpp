@@ -9,6 +9,7 @@
 #include <iomanip>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "alvio/common/arg_parser.h"
 #include "alvio/common/error.h"
@@ -39,6 +40,7 @@ int main(int argc, char** argv) {
   args.option("line-angle", "line map tolerance: angle to a true edge (deg)", "3");
   args.option("voxel-tolerance", "voxel centre to a true surface (m); default 2 voxels", "");
   args.option("json", "write every figure to this JSON file");
+  args.option("per-line", "write each map line's error (true world) to this CSV file");
   try {
     if (!args.parse(argc, argv)) return 0;
     if (args.positional().size() != 2) throw Error("give RUN_DIR and SEQUENCE_DIR");
@@ -128,6 +130,23 @@ int main(int argc, char** argv) {
               << sizeOf(run / kLinesCsvFileName) << " B, lines.ply "
               << sizeOf(run / kLinesPlyFileName) << " B\n";
     if (args.isSet("json")) writeFileAtomically(args.get("json"), report.dump(2) + "\n");
+    if (args.isSet("per-line")) {
+      std::ostringstream os;
+      os << "id,length_m,observations,landmarks,edge,angle_deg,midpoint_distance_m,"
+            "surface_distance_m,precision\n";
+      for (const MapLine& l : map_lines) {
+        const Segment3 s{traj.alignment.apply(l.p0), traj.alignment.apply(l.p1)};
+        const LineError e = lineErrorToNearestEdge(s, edges);
+        const double surface =
+            std::max({surfaces(s.p0), surfaces(s.p1), surfaces(0.5 * (s.p0 + s.p1))});
+        const LineMapEvaluation one = evaluateLineMap({s}, edges, options.line_distance_tol_m,
+                                                      options.line_angle_tol_deg * M_PI / 180.0);
+        os << l.id << "," << s.length() << "," << l.observations << "," << l.landmarks << ","
+           << e.edge << "," << e.angle_deg << "," << e.midpoint_distance_m << "," << surface << ","
+           << one.precision << "\n";
+      }
+      writeFileAtomically(args.get("per-line"), os.str());
+    }
     return 0;
   } catch (const Error& e) {
     std::cerr << "alvio_map_truth: error: " << e.what() << "\n";

@@ -27,6 +27,22 @@ inline Eigen::Isometry3d randomPose(std::mt19937& rng, double translation_scale)
   return T;
 }
 
+/// A camera at `position` looking at `target` (z forward, x right, y down-ish).
+inline Eigen::Isometry3d lookAt(const Eigen::Vector3d& position, const Eigen::Vector3d& target) {
+  const Eigen::Vector3d z = (target - position).normalized();
+  const Eigen::Vector3d x = Eigen::Vector3d::UnitZ().cross(z).normalized();
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() << x, z.cross(x), z;
+  T.translation() = position;
+  return T;
+}
+
+inline Eigen::Vector2d projectNormalised(const Eigen::Isometry3d& T_w_c,
+                                         const Eigen::Vector3d& p_w) {
+  const Eigen::Vector3d p_c = T_w_c.inverse() * p_w;
+  return p_c.head<2>() / p_c.z();
+}
+
 /// Jacobian of f: R^n -> R^m by central differences.
 inline Eigen::MatrixXd numericJacobian(
     const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& f, const Eigen::VectorXd& x,

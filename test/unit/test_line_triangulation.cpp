@@ -14,24 +14,11 @@
 #include "line_test_utils.h"
 
 using namespace alvio;
+using alvio::test::lookAt;
+using alvio::test::projectNormalised;
 
 namespace {
 constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
-
-// A camera at `position` looking at `target` (z forward, x right, y down-ish).
-Eigen::Isometry3d lookAt(const Eigen::Vector3d& position, const Eigen::Vector3d& target) {
-  const Eigen::Vector3d z = (target - position).normalized();
-  const Eigen::Vector3d x = Eigen::Vector3d::UnitZ().cross(z).normalized();
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() << x, z.cross(x), z;
-  T.translation() = position;
-  return T;
-}
-
-Eigen::Vector2d projectNormalised(const Eigen::Isometry3d& T_w_c, const Eigen::Vector3d& p_w) {
-  const Eigen::Vector3d p_c = T_w_c.inverse() * p_w;
-  return p_c.head<2>() / p_c.z();
-}
 
 // A view of the part [a, b] (fractions along P->Q) of the segment, with pixel noise.
 LineView observe(const Eigen::Isometry3d& T_w_c, const Eigen::Vector3d& P, const Eigen::Vector3d& Q,
@@ -198,6 +185,27 @@ TEST(LineTriangulation, ExtentIsTheUnionOfTheObservedParts) {
   ASSERT_TRUE(lineExtent(truth, views, &start, &end));
   EXPECT_LT((start - (kP + 0.2 * (kQ - kP))).norm(), 1e-9);
   EXPECT_LT((end - (kP + 0.9 * (kQ - kP))).norm(), 1e-9);
+}
+
+TEST(LineTriangulation, ExtentSkipsEndpointsSeenAlongTheLine) {
+  std::mt19937 rng(25);
+  const Eigen::Vector3d u = (kQ - kP).normalized();
+  const Eigen::Vector3d side = u.cross(Eigen::Vector3d::UnitZ()).normalized();
+  // Seen almost end-on (rays within ~3 deg of the line), two pixels off: that endpoint's place
+  // along the line is metres off.
+  LineView along = observe(lookAt(kP - 3.0 * u + 0.15 * side, kP), kP, kQ, 0.0, 1.0, 0, rng);
+  along.end_norm.x() += 2.0 / 460;
+  const LineViews views = {observe(lookAt({0, -0.5, 0}, kP), kP, kQ, 0.2, 0.6, 0, rng), along};
+  const PluckerLine truth = PluckerLine::fromPoints(kP, kQ);
+  Eigen::Vector3d start, end;
+  LineTriangulationOptions options;
+  options.extent_min_ray_angle_deg = 0.0;
+  ASSERT_TRUE(lineExtent(truth, views, &start, &end, options));
+  EXPECT_GT((end - kQ).norm(), 0.5);  // the end-on view sets the extent, badly
+  options.extent_min_ray_angle_deg = 10.0;
+  ASSERT_TRUE(lineExtent(truth, views, &start, &end, options));
+  EXPECT_LT((start - (kP + 0.2 * (kQ - kP))).norm(), 1e-9);
+  EXPECT_LT((end - (kP + 0.6 * (kQ - kP))).norm(), 1e-9);
 }
 
 TEST(LineLandmark, ExtentGrowsAndFollowsTheLine) {

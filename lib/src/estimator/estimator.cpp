@@ -406,7 +406,8 @@ void Estimator::slideWindow() {
       // (1 us of slack: t0 went through double seconds and lost a few ns.)
       const int64_t t0_ns = secToNs(t0) + 1000;
       all_frames_.erase(all_frames_.begin(), all_frames_.upper_bound(t0_ns));
-      lines_.removeFrame(t0_exact_ns, T_w_c0);
+      // Before initialisation the window's poses are placeholders, unfit for the map.
+      lines_.removeFrame(t0_exact_ns, status_ == EstimatorStatus::kTracking ? &T_w_c0 : nullptr);
       if (status_ == EstimatorStatus::kTracking) {
         const Eigen::Matrix3d R_c_old = back_R0_ * T_b_c_.linear();
         const Eigen::Vector3d p_c_old = back_P0_ + back_R0_ * T_b_c_.translation();
@@ -425,7 +426,9 @@ void Estimator::slideWindow() {
       acc_buf_[W_ - 1].push_back(acc_buf_[W_][k]);
       gyr_buf_[W_ - 1].push_back(gyr_buf_[W_][k]);
     }
-    lines_.removeFrame(header_ns_[W_ - 1], cameraPose(header_ns_[W_ - 1]));
+    const Eigen::Isometry3d T_w_c = cameraPose(header_ns_[W_ - 1]);
+    lines_.removeFrame(header_ns_[W_ - 1],
+                       status_ == EstimatorStatus::kTracking ? &T_w_c : nullptr);
     headers_[W_ - 1] = headers_[W_];
     header_ns_[W_ - 1] = header_ns_[W_];
     intensity_[W_ - 1] = intensity_[W_];

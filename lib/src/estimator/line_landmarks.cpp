@@ -26,18 +26,18 @@ void LineLandmarks::addFrame(
   }
 }
 
-void LineLandmarks::removeFrame(int64_t frame_ns, const Eigen::Isometry3d& T_w_c) {
+void LineLandmarks::removeFrame(int64_t frame_ns, const Eigen::Isometry3d* T_w_c) {
   for (auto it = landmarks_.begin(); it != landmarks_.end();) {
     LineLandmark& l = it->second;
     const auto obs = l.observations.find(frame_ns);
-    if (obs != l.observations.end()) {
+    if (obs != l.observations.end() && T_w_c) {
       LineView v;
-      v.T_w_c = T_w_c;
+      v.T_w_c = *T_w_c;
       v.start_norm = obs->second.start_norm;
       v.end_norm = obs->second.end_norm;
       history_[l.id].push_back(v);
-      l.observations.erase(obs);
     }
+    if (obs != l.observations.end()) l.observations.erase(obs);
     if (!l.observations.empty()) {
       ++it;
       continue;
@@ -51,7 +51,7 @@ void LineLandmarks::removeFrame(int64_t frame_ns, const Eigen::Isometry3d& T_w_c
         retired.setLine(line, LineLandmarkStatus::kOptimised);
         retired.has_extent = false;
         Eigen::Vector3d a, b;
-        if (lineExtent(line, views, &a, &b)) {
+        if (lineExtent(line, views, &a, &b, triangulation_)) {
           retired.start_w = a;
           retired.end_w = b;
           retired.has_extent = true;
@@ -129,7 +129,7 @@ void LineLandmarks::triangulate(const std::function<Eigen::Isometry3d(int64_t)>&
       continue;  // degenerate for now; more motion may make it observable
     l.setLine(line, LineLandmarkStatus::kTriangulated);
     Eigen::Vector3d a, b;
-    if (lineExtent(line, viewsOf(l, camera_pose), &a, &b)) {
+    if (lineExtent(line, viewsOf(l, camera_pose), &a, &b, triangulation_)) {
       l.start_w = a;
       l.end_w = b;
       l.has_extent = true;
@@ -141,7 +141,7 @@ void LineLandmarks::updateExtents(const std::function<Eigen::Isometry3d(int64_t)
   for (auto& [id, l] : landmarks_) {
     if (!usable(l)) continue;
     Eigen::Vector3d a, b;
-    if (lineExtent(l.line_w, viewsOf(l, camera_pose), &a, &b)) l.unionExtent(a, b);
+    if (lineExtent(l.line_w, viewsOf(l, camera_pose), &a, &b, triangulation_)) l.unionExtent(a, b);
   }
 }
 

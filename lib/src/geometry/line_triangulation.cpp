@@ -83,6 +83,8 @@ LineTriangulationOptions LineTriangulationOptions::load(const YamlReader& yaml,
   o.min_depth = yaml.getDouble(p + "min_depth", o.min_depth);
   o.refine_max_iterations = yaml.getInt(p + "refine_max_iterations", o.refine_max_iterations);
   o.refine_huber_scale = yaml.getDouble(p + "refine_huber_scale", o.refine_huber_scale);
+  o.extent_min_ray_angle_deg =
+      yaml.getDouble(p + "extent_min_ray_angle_deg", o.extent_min_ray_angle_deg);
   o.validate(yaml.path() + ": " + prefix);
   return o;
 }
@@ -99,6 +101,8 @@ void LineTriangulationOptions::validate(const std::string& where) const {
   check(min_depth >= 0, "min_depth", "must not be negative");
   check(refine_max_iterations >= 0, "refine_max_iterations", "must not be negative");
   check(refine_huber_scale >= 0, "refine_huber_scale", "must not be negative");
+  check(extent_min_ray_angle_deg >= 0 && extent_min_ray_angle_deg < 90, "extent_min_ray_angle_deg",
+        "must be in [0, 90)");
 }
 
 const char* toString(LineTriangulationStatus status) {
@@ -227,15 +231,17 @@ bool closestPointOnLineToRay(const PluckerLine& line, const Eigen::Vector3d& o,
 }
 
 bool lineExtent(const PluckerLine& line_w, const LineViews& views, Eigen::Vector3d* start_w,
-                Eigen::Vector3d* end_w) {
+                Eigen::Vector3d* end_w, const LineTriangulationOptions& options) {
+  const Eigen::Vector3d u = line_w.d.normalized();
+  const double max_cos = std::cos(options.extent_min_ray_angle_deg * kDegToRad);
   double s_min = std::numeric_limits<double>::infinity();
   double s_max = -s_min;
   for (const LineView& v : views) {
     for (const Eigen::Vector2d& p : {v.start_norm, v.end_norm}) {
+      const Eigen::Vector3d ray = v.T_w_c.linear() * homogeneous(p);
+      if (std::abs(u.dot(ray)) > max_cos * ray.norm()) continue;
       double s, t;
-      if (!closestPointOnLineToRay(line_w, v.T_w_c.translation(), v.T_w_c.linear() * homogeneous(p),
-                                   &s, &t) ||
-          t <= 0.0)
+      if (!closestPointOnLineToRay(line_w, v.T_w_c.translation(), ray, &s, &t) || t <= 0.0)
         continue;
       s_min = std::min(s_min, s);
       s_max = std::max(s_max, s);
@@ -243,7 +249,6 @@ bool lineExtent(const PluckerLine& line_w, const LineViews& views, Eigen::Vector
   }
   if (!(s_min <= s_max)) return false;
   const Eigen::Vector3d p0 = line_w.closestPointToOrigin();
-  const Eigen::Vector3d u = line_w.d.normalized();
   *start_w = p0 + s_min * u;
   *end_w = p0 + s_max * u;
   return true;

@@ -27,7 +27,9 @@ class LineLandmarks {
   /// A frame leaves the window: its observations move to the lines' history with the frame's
   /// final camera pose T_w_c. A line left with no window observation retires: it is refined
   /// over its whole history (all its observations, poses fixed) and queued for takeRetired().
-  void removeFrame(int64_t frame_ns, const Eigen::Isometry3d& T_w_c);
+  /// `T_w_c` null: the frame has no estimated pose (before initialisation), so its
+  /// observations are dropped instead of kept for the retirement refinement.
+  void removeFrame(int64_t frame_ns, const Eigen::Isometry3d* T_w_c);
 
   /// Triangulate every untriangulated line with enough observations. `camera_pose(ns)`
   /// gives T_w_c of a window frame.

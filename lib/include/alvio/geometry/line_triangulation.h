@@ -38,6 +38,9 @@ struct LineTriangulationOptions {
   /// Refinement: Ceres iterations and the Huber scale in normalised units (0: no loss).
   int refine_max_iterations = 10;
   double refine_huber_scale = 0.0;
+  /// Extent: an observed endpoint whose ray meets the line at less than this angle [deg] is
+  /// not used, because its position along the line is ill-conditioned (error / sin(angle)).
+  double extent_min_ray_angle_deg = 10.0;
 
   static LineTriangulationOptions load(const YamlReader& yaml, const std::string& prefix);
   void validate(const std::string& where) const;
@@ -81,8 +84,10 @@ bool closestPointOnLineToRay(const PluckerLine& line, const Eigen::Vector3d& o,
 
 /// The segment's extent: every observed endpoint's back-projected ray is brought to its
 /// closest point on the line; the union of those points along the line gives the endpoints
-/// (ordered along d). False if no endpoint could be placed in front of its camera.
+/// (ordered along d). Endpoints whose ray meets the line at less than
+/// `options.extent_min_ray_angle_deg` are skipped. False if no endpoint could be placed in
+/// front of its camera.
 bool lineExtent(const PluckerLine& line_w, const LineViews& views, Eigen::Vector3d* start_w,
-                Eigen::Vector3d* end_w);
+                Eigen::Vector3d* end_w, const LineTriangulationOptions& options = {});
 
 }  // namespace alvio
