@@ -160,6 +160,7 @@ void toMsg(const alvio::KeyframeLandmarks& keyframe, const std::vector<double>& 
   for (std::size_t i = 0; i < keyframe.points.size(); ++i) {
     msg->points[i].id = keyframe.points[i].id;
     msg->points[i].position = toPoint(keyframe.points[i].p_w);
+    msg->points[i].parallax_deg = keyframe.points[i].parallax_deg;
   }
   msg->lines.resize(keyframe.lines.size());
   for (std::size_t i = 0; i < keyframe.lines.size(); ++i) {
@@ -177,7 +178,8 @@ alvio::KeyframeLandmarks fromMsg(const alvio::MapKeyframe& msg, double max_direc
   alvio::KeyframeLandmarks kf;
   kf.t = msg.header.stamp.toSec();
   kf.T_w_c = fromPose(msg.camera_pose);
-  for (const auto& p : msg.points) kf.points.push_back({p.id, fromPoint(p.position)});
+  for (const auto& p : msg.points)
+    kf.points.push_back({p.id, fromPoint(p.position), p.parallax_deg});
   for (const auto& l : msg.lines) {
     if (l.direction_std_deg < 0 || l.direction_std_deg > max_direction_std_deg) continue;
     kf.lines.push_back({l.id, fromPoint(l.start), fromPoint(l.end), l.observations});

@@ -1,6 +1,24 @@
 #include "alvio/mapping/estimator_keyframe_feed.h"
 
+#include <algorithm>
+#include <cmath>
+
 namespace alvio {
+
+namespace {
+// Largest angle at p between the ray from centres[first] and the rays from centres[k],
+// k in (first, last].
+double parallaxDeg(const Eigen::Vector3d& p, const std::vector<Eigen::Vector3d>& centres, int first,
+                   int last) {
+  const Eigen::Vector3d a = (centres.at(first) - p).normalized();
+  double max_angle = 0;
+  for (int k = first + 1; k <= last && k < static_cast<int>(centres.size()); ++k) {
+    const Eigen::Vector3d b = (centres[k] - p).normalized();
+    max_angle = std::max(max_angle, std::atan2(a.cross(b).norm(), a.dot(b)));
+  }
+  return max_angle * 180.0 / M_PI;
+}
+}  // namespace
 
 KeyframeLandmarks EstimatorKeyframeFeed::keyframe(const Estimator& estimator, int index) const {
   const auto window = estimator.windowStates();
@@ -11,10 +29,13 @@ KeyframeLandmarks EstimatorKeyframeFeed::keyframe(const Estimator& estimator, in
   T_w_b.linear() = s.q.toRotationMatrix();
   T_w_b.translation() = s.p;
   kf.T_w_c = T_w_b * T_b_c_;
+  std::vector<Eigen::Vector3d> centres;
+  for (const BodyState& b : window) centres.push_back(b.p + b.q * T_b_c_.translation());
   const auto& landmarks = estimator.points().landmarks();
   for (const auto& [id, p_w] : estimator.landmarkPositions()) {
     auto it = landmarks.find(id);
-    if (it != landmarks.end() && it->second.start_frame == index) kf.points.push_back({id, p_w});
+    if (it == landmarks.end() || it->second.start_frame != index) continue;
+    kf.points.push_back({id, p_w, parallaxDeg(p_w, centres, index, it->second.endFrame())});
   }
   return kf;
 }

@@ -19,6 +19,10 @@ MappingOptions MappingOptions::load(const YamlReader& yaml, const std::string& p
   o.write_scene = yaml.getBool(prefix + ".write_scene", o.write_scene);
   o.max_line_direction_std_deg =
       yaml.getDouble(prefix + ".max_line_direction_std_deg", o.max_line_direction_std_deg);
+  o.min_point_parallax_deg =
+      yaml.getDouble(prefix + ".min_point_parallax_deg", o.min_point_parallax_deg);
+  if (!(o.min_point_parallax_deg >= 0 && o.min_point_parallax_deg < 90))
+    throw Error(yaml.path() + ": " + prefix + ".min_point_parallax_deg must be in [0, 90)");
   o.lines = LineMapOptions::load(yaml, prefix + ".lines");
   o.octomap = OccupancyMapOptions::load(yaml, prefix + ".octomap");
   for (const std::string& key : yaml.unknownKeys())
@@ -50,11 +54,17 @@ void MapBuilder::addKeyframe(const KeyframeLandmarks& keyframe) {
   ++keyframes_;
   lines_.beginKeyframe();
   const Eigen::Vector3d camera = keyframe.T_w_c.translation();
-  for (const LandmarkPoint& p : keyframe.points)
-    if (p.p_w.allFinite()) points_[p.id] = p.p_w;
+  KeyframeLandmarks kept = keyframe;
+  kept.points.clear();
+  for (const LandmarkPoint& p : keyframe.points) {
+    if (!p.p_w.allFinite()) continue;
+    if (p.parallax_deg >= 0 && p.parallax_deg < options_.min_point_parallax_deg) continue;
+    points_[p.id] = p.p_w;
+    kept.points.push_back(p);
+  }
   for (const LandmarkSegment& l : keyframe.lines)
     lines_.addSegment(l.id, l.p0_w, l.p1_w, l.observations, camera);
-  occupancy_.insertKeyframe(keyframe);
+  occupancy_.insertKeyframe(kept);
 }
 
 void MapBuilder::addTrajectoryPose(const StampedPose& T_w_b) {

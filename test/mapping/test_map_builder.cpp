@@ -76,6 +76,21 @@ TEST(MapBuilder, OptionsFromTheShippedConfigWithoutUnknownKeyWarnings) {
   EXPECT_NE(warnings.front().find("mapping.octomap.resolutoin"), std::string::npos);
 }
 
+TEST(MapBuilder, PointsSeenWithTooLittleParallaxStayOut) {
+  MappingOptions o;
+  o.min_point_parallax_deg = 2.0;
+  MapBuilder map(o);
+  KeyframeLandmarks kf;
+  kf.points = {{1, {2, 0, 0}, 0.5}, {2, {0, 2, 0}, 5.0}, {3, {0, 0, 2}, -1.0}};
+  map.addKeyframe(kf);
+  EXPECT_EQ(map.points().count(1), 0u);  // too little parallax
+  EXPECT_EQ(map.points().count(2), 1u);
+  EXPECT_EQ(map.points().count(3), 1u);  // unknown parallax: kept
+  EXPECT_FALSE(map.occupancyMap().isOccupied({2, 0, 0}));
+  EXPECT_TRUE(map.occupancyMap().isOccupied({0, 2, 0}));
+  EXPECT_TRUE(map.occupancyMap().isOccupied({0, 0, 2}));
+}
+
 TEST(EstimatorKeyframeFeed, ReportsOldestKeyframeLandmarksOnce) {
   const Config c = Config::load(test::sourcePath("config/euroc.yaml"));
   test::ScenarioOptions so;
@@ -108,6 +123,8 @@ TEST(EstimatorKeyframeFeed, ReportsOldestKeyframeLandmarksOnce) {
     EXPECT_EQ(kf->points.size(), anchored);
     for (const LandmarkPoint& p : kf->points) {
       EXPECT_LT((positions.at(p.id) - p.p_w).norm(), 1e-12);
+      EXPECT_GE(p.parallax_deg, 0.0);
+      EXPECT_LT(p.parallax_deg, 90.0);
       EXPECT_GT((kf->T_w_c.inverse() * p.p_w).z(), 0.0) << "behind the reporting camera";
     }
     keyframes.push_back(*kf);
@@ -134,6 +151,11 @@ TEST(EstimatorKeyframeFeed, ReportsOldestKeyframeLandmarksOnce) {
     settled.push_back(&kf);
   }
   ASSERT_GT(settled.size(), 10u);
+  // A moving camera: the settled keyframes' points were seen with parallax.
+  double max_parallax = 0;
+  for (const KeyframeLandmarks* kf : settled)
+    for (const LandmarkPoint& p : kf->points) max_parallax = std::max(max_parallax, p.parallax_deg);
+  EXPECT_GT(max_parallax, 2.0);
   const Similarity3 align = alignPoints(est, truth, AlignmentMode::kSE3);
   for (std::size_t i = 0; i < est.size(); ++i)
     EXPECT_LT((align.apply(est[i]) - truth[i]).norm(), 0.1);

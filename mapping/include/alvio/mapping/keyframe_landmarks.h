@@ -14,6 +14,9 @@ namespace alvio {
 struct LandmarkPoint {
   int id = -1;
   Eigen::Vector3d p_w = Eigen::Vector3d::Zero();
+  /// Largest angle at the point between the rays of two cameras that saw it [deg]; its
+  /// depth error grows as this shrinks. Negative: unknown.
+  double parallax_deg = -1;
 };
 
 /// A 3D line landmark as a finite segment: its two endpoints (the observed extent on the

@@ -18,10 +18,13 @@ class YamlReader;
 
 /// The `mapping:` section of the configuration.
 struct MappingOptions {
-  bool enabled = true;          ///< the offline runner builds and writes the map
-  bool write_scene = true;      ///< write map.3Dscene (MRPT) besides the other files
+  bool enabled = true;      ///< the offline runner builds and writes the map
+  bool write_scene = true;  ///< write map.3Dscene (MRPT) besides the other files
   /// Lines whose direction is less certain than this (1 sigma, deg) stay out of the map.
   double max_line_direction_std_deg = 2.0;
+  /// Points seen with less parallax than this [deg] stay out of the map (their depth is
+  /// uncertain); points of unknown parallax are kept.
+  double min_point_parallax_deg = 2.0;
   LineMapOptions lines;         ///< mapping.lines.*
   OccupancyMapOptions octomap;  ///< mapping.octomap.*
 
