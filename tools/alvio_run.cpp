@@ -117,7 +117,7 @@ int main(int argc, char** argv) {
       std::cout << "MRPT logs:";
       for (const std::string* f : {&p.rawlog, &p.scene, &p.text})
         if (!f->empty()) std::cout << " " << *f;
-      std::cout << " (logger " << r.observer_ms << " ms)\n";
+      std::cout << " (observers " << r.observer_ms << " ms in all)\n";
     }
     if (r.evaluation) std::cout << "ATE_RMSE=" << r.evaluation->ate_translation_m.rmse << "\n";
     if (r.interrupted) {

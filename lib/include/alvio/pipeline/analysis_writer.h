@@ -18,6 +18,7 @@ class AnalysisWriter : public RunObserver {
   /// Creates `dir` and opens the three files; throws alvio::Error naming the path.
   explicit AnalysisWriter(const std::string& dir);
   void onFrame(const FrameView& frame) override;
+  std::string stage() const override { return "analysis"; }
   void onFinish(const RunResult& result) override;
   std::size_t windows() const { return windows_; }
 

@@ -1,8 +1,9 @@
 #pragma once
 // Hooks into the offline runner for components that record or consume a run
 // (the MRPT logger, map builders) without the runner knowing them. Observers
-// are called synchronously, in data order, from the runner's thread; their time
-// is accounted separately from the pipeline's (RunResult::observer_ms).
+// are called synchronously, in data order, from the runner's thread. Their
+// per-frame time (onImu and onFrame) is a stage of its own in timing.csv, named
+// by stage(); all of it is also summed in RunResult::observer_ms.
 
 #include <cstdint>
 #include <opencv2/core.hpp>
@@ -45,6 +46,8 @@ class RunObserver {
   virtual void onFrame(const FrameView& frame) {}
   /// After the runner wrote its own files (trajectory.tum, summary.json ...).
   virtual void onFinish(const RunResult& result) {}
+  /// The timing stage its onImu and onFrame time is reported under ("mapping", "logging").
+  virtual std::string stage() const { return "observers"; }
 };
 
 }  // namespace alvio

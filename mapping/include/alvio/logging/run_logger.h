@@ -33,6 +33,7 @@ class RunLogger : public RunObserver {
   void onStart(const RunInfo& info) override;
   void onImu(const ImuSample& sample) override;
   void onFrame(const FrameView& frame) override;
+  std::string stage() const override { return "logging"; }
   void onFinish(const RunResult& result) override;
 
   /// The estimator's map in the output world frame (empty before initialisation).

@@ -20,6 +20,7 @@ class MapObserver : public RunObserver {
   void onStart(const RunInfo& info) override;
   void onFrame(const FrameView& frame) override;
   void onFinish(const RunResult& result) override;
+  std::string stage() const override { return "mapping"; }
 
   const MapBuilder& map() const { return map_; }
   MapSummary summary() const { return map_.summary(); }
