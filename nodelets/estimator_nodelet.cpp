@@ -261,6 +261,7 @@ class EstimatorNodelet : public GuardedNodelet {
       publishPose(header, state);
       publishMapInput(state, retired);
     }
+    const ros::WallTime odometry_out = ros::WallTime::now();
     publishWindow(header);
     for (const auto& e : events) last_event_ = e.message;
     auto status = boost::make_shared<alvio::PipelineStatus>();
@@ -281,6 +282,10 @@ class EstimatorNodelet : public GuardedNodelet {
     status->window_lines = static_cast<int32_t>(estimator_->lineSegments().size());
     status->frontend_ms = features.stats.total_ms;
     status->estimator_ms = estimator_ms;
+    status->latency_ms =
+        features.received.isZero()
+            ? -1.0  // a sender that does not fill it in
+            : (ros::Time(odometry_out.sec, odometry_out.nsec) - features.received).toSec() * 1e3;
     status_pub_.publish(status);
   }
 

@@ -54,6 +54,7 @@ class TrackerNodelet : public GuardedNodelet {
   }
 
   void onImage(const sensor_msgs::ImageConstPtr& image) {
+    const ros::WallTime received = ros::WallTime::now();
     const std::string problem = imageMessageProblem(*image);
     if (!problem.empty()) {
       NODELET_ERROR_THROTTLE(5.0, "image at %.3f s is malformed: %s: skipped",
@@ -103,6 +104,7 @@ class TrackerNodelet : public GuardedNodelet {
     const alvio::FeatureFrame frame = front_end_->track(gray->image, t_ns, &timing);
     auto out = boost::make_shared<SharedTrackedFrame>();
     toMsg(frame, timing, image->header, &out->features);
+    out->features.received = ros::Time(received.sec, received.nsec);
     out->image = image;  // the received pointer itself: no copy
     frame_pub_.publish(out);
   }

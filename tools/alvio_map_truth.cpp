@@ -133,7 +133,7 @@ int main(int argc, char** argv) {
     if (args.isSet("per-line")) {
       std::ostringstream os;
       os << "id,length_m,observations,landmarks,edge,angle_deg,midpoint_distance_m,"
-            "surface_distance_m,precision\n";
+            "surface_distance_m,midpoint_surface_distance_m,precision\n";
       for (const MapLine& l : map_lines) {
         const Segment3 s{traj.alignment.apply(l.p0), traj.alignment.apply(l.p1)};
         const LineError e = lineErrorToNearestEdge(s, edges);
@@ -143,7 +143,7 @@ int main(int argc, char** argv) {
                                                       options.line_angle_tol_deg * M_PI / 180.0);
         os << l.id << "," << s.length() << "," << l.observations << "," << l.landmarks << ","
            << e.edge << "," << e.angle_deg << "," << e.midpoint_distance_m << "," << surface << ","
-           << one.precision << "\n";
+           << surfaces(0.5 * (s.p0 + s.p1)) << "," << one.precision << "\n";
       }
       writeFileAtomically(args.get("per-line"), os.str());
     }

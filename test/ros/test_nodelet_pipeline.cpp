@@ -169,6 +169,8 @@ TEST(NodeletPipeline, OdometryAndTfArriveAtTheImageRateWithImageStamps) {
   for (const auto& [stamp, pose] : g_rec.odometry)
     ASSERT_TRUE(image_stamps.count(stamp)) << "odometry stamp " << stamp << " is no image's";
   EXPECT_EQ(g_rec.status.state, alvio::PipelineStatus::TRACKING);
+  // The latency is measured (its size depends on the machine's load: not checked here).
+  EXPECT_GT(g_rec.status.latency_ms, 0.0);
 }
 
 TEST(NodeletPipeline, AteWithinOneAndAHalfTimesTheOfflineRunners) {

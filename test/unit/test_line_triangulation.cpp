@@ -208,6 +208,29 @@ TEST(LineTriangulation, ExtentSkipsEndpointsSeenAlongTheLine) {
   EXPECT_LT((end - (kP + 0.6 * (kQ - kP))).norm(), 1e-9);
 }
 
+TEST(LineTriangulation, ExtentTrimLeavesOutTheViewsReachingFurthest) {
+  std::mt19937 rng(26);
+  const double parts[][2] = {{0.2, 0.6}, {0.25, 0.6}, {0.2, 0.55}, {0.3, 0.65}, {0.0, 1.0}};
+  LineViews views;
+  for (int i = 0; i < 5; ++i)
+    views.push_back(observe(lookAt({0.1 * i, -0.5 + 0.2 * i, 0}, kP), kP, kQ, parts[i][0],
+                            parts[i][1], 0, rng));
+  const PluckerLine truth = PluckerLine::fromPoints(kP, kQ);
+  auto fraction = [&](const Eigen::Vector3d& p) {
+    return (p - kP).dot(kQ - kP) / (kQ - kP).squaredNorm();
+  };
+  Eigen::Vector3d start, end;
+  LineTriangulationOptions options;
+  options.extent_trim_fraction = 0.0;
+  ASSERT_TRUE(lineExtent(truth, views, &start, &end, options));
+  EXPECT_NEAR(std::min(fraction(start), fraction(end)), 0.0, 1e-9);
+  EXPECT_NEAR(std::max(fraction(start), fraction(end)), 1.0, 1e-9);
+  options.extent_trim_fraction = 0.2;  // one of five views at each end
+  ASSERT_TRUE(lineExtent(truth, views, &start, &end, options));
+  EXPECT_NEAR(std::min(fraction(start), fraction(end)), 0.2, 1e-9);
+  EXPECT_NEAR(std::max(fraction(start), fraction(end)), 0.65, 1e-9);
+}
+
 TEST(LineLandmark, ExtentGrowsAndFollowsTheLine) {
   LineLandmark lm;
   lm.id = 7;

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <memory>
 
@@ -85,6 +86,7 @@ LineTriangulationOptions LineTriangulationOptions::load(const YamlReader& yaml,
   o.refine_huber_scale = yaml.getDouble(p + "refine_huber_scale", o.refine_huber_scale);
   o.extent_min_ray_angle_deg =
       yaml.getDouble(p + "extent_min_ray_angle_deg", o.extent_min_ray_angle_deg);
+  o.extent_trim_fraction = yaml.getDouble(p + "extent_trim_fraction", o.extent_trim_fraction);
   o.validate(yaml.path() + ": " + prefix);
   return o;
 }
@@ -101,6 +103,8 @@ void LineTriangulationOptions::validate(const std::string& where) const {
   check(min_depth >= 0, "min_depth", "must not be negative");
   check(refine_max_iterations >= 0, "refine_max_iterations", "must not be negative");
   check(refine_huber_scale >= 0, "refine_huber_scale", "must not be negative");
+  check(extent_trim_fraction >= 0 && extent_trim_fraction < 0.5, "extent_trim_fraction",
+        "must be in [0, 0.5)");
   check(extent_min_ray_angle_deg >= 0 && extent_min_ray_angle_deg < 90, "extent_min_ray_angle_deg",
         "must be in [0, 90)");
 }
@@ -234,20 +238,29 @@ bool lineExtent(const PluckerLine& line_w, const LineViews& views, Eigen::Vector
                 Eigen::Vector3d* end_w, const LineTriangulationOptions& options) {
   const Eigen::Vector3d u = line_w.d.normalized();
   const double max_cos = std::cos(options.extent_min_ray_angle_deg * kDegToRad);
-  double s_min = std::numeric_limits<double>::infinity();
-  double s_max = -s_min;
+  // Each view's observed part [lo, hi] along the line.
+  std::vector<double> los, his;
   for (const LineView& v : views) {
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
     for (const Eigen::Vector2d& p : {v.start_norm, v.end_norm}) {
       const Eigen::Vector3d ray = v.T_w_c.linear() * homogeneous(p);
       if (std::abs(u.dot(ray)) > max_cos * ray.norm()) continue;
       double s, t;
       if (!closestPointOnLineToRay(line_w, v.T_w_c.translation(), ray, &s, &t) || t <= 0.0)
         continue;
-      s_min = std::min(s_min, s);
-      s_max = std::max(s_max, s);
+      lo = std::min(lo, s);
+      hi = std::max(hi, s);
     }
+    if (lo > hi) continue;
+    los.push_back(lo);
+    his.push_back(hi);
   }
-  if (!(s_min <= s_max)) return false;
+  if (los.empty()) return false;
+  // The union, without the views reaching furthest out at each end.
+  const std::size_t k = static_cast<std::size_t>(options.extent_trim_fraction * los.size());
+  std::nth_element(los.begin(), los.begin() + k, los.end());
+  std::nth_element(his.begin(), his.begin() + k, his.end(), std::greater<double>());
+  const double s_min = los[k], s_max = std::max(his[k], s_min);
   const Eigen::Vector3d p0 = line_w.closestPointToOrigin();
   *start_w = p0 + s_min * u;
   *end_w = p0 + s_max * u;

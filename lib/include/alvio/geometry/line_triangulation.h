@@ -41,6 +41,9 @@ struct LineTriangulationOptions {
   /// Extent: an observed endpoint whose ray meets the line at less than this angle [deg] is
   /// not used, because its position along the line is ill-conditioned (error / sin(angle)).
   double extent_min_ray_angle_deg = 10.0;
+  /// Extent: this fraction of the views reaching furthest out at each end is left out
+  /// (0: the union of all observed parts).
+  double extent_trim_fraction = 0.1;
 
   static LineTriangulationOptions load(const YamlReader& yaml, const std::string& prefix);
   void validate(const std::string& where) const;
@@ -83,8 +86,9 @@ bool closestPointOnLineToRay(const PluckerLine& line, const Eigen::Vector3d& o,
                              const Eigen::Vector3d& r, double* s_line, double* t_ray);
 
 /// The segment's extent: every observed endpoint's back-projected ray is brought to its
-/// closest point on the line; the union of those points along the line gives the endpoints
-/// (ordered along d). Endpoints whose ray meets the line at less than
+/// closest point on the line; the union of the views' parts along the line gives the
+/// endpoints (ordered along d), less the `options.extent_trim_fraction` of views reaching
+/// furthest at each end. Endpoints whose ray meets the line at less than
 /// `options.extent_min_ray_angle_deg` are skipped. False if no endpoint could be placed in
 /// front of its camera.
 bool lineExtent(const PluckerLine& line_w, const LineViews& views, Eigen::Vector3d* start_w,
