@@ -103,7 +103,7 @@ if [[ -z $gt ]]; then
   echo "trajectory: $run/trajectory.tum ($(wc -l <"$run/trajectory.tum") poses; no ground truth given)"
   exit 0
 fi
-"$BIN/alvio_eval" --gt "$out/groundtruth.tum" --est "$run/trajectory.tum" --align se3 \
+"$BIN/alvio_eval" --gt "$gt" --est "$run/trajectory.tum" --align se3 \
   --json "$run/eval.json" --plot "$run" >"$run/eval.txt"
 ate=$(python3 -c 'import json, sys; print("%.4f" % json.load(open(sys.argv[1]))["ate_translation_m"]["rmse"])' "$run/eval.json")
 grep -h "dropped\|frames were lost" "$ROS_LOG_DIR"/*/*.log 2>/dev/null | tail -3 >&2 || true
