@@ -46,6 +46,18 @@ namespace {
 constexpr double kMaxRayLength_m = 100.0;
 }  // namespace
 
+void OccupancyMap::syncInnerNodes() const {
+  if (!inner_nodes_stale_) return;
+  tree_->updateInnerOccupancy();
+  tree_->prune();
+  inner_nodes_stale_ = false;
+}
+
+const octomap::OcTree& OccupancyMap::tree() const {
+  syncInnerNodes();
+  return *tree_;
+}
+
 void OccupancyMap::insert(const Eigen::Vector3d& origin_w,
                           const std::vector<Eigen::Vector3d>& points_w) {
   if (!origin_w.allFinite()) return;
@@ -54,8 +66,9 @@ void OccupancyMap::insert(const Eigen::Vector3d& origin_w,
     for (const Eigen::Vector3d& p : points_w) {
       if (!p.allFinite()) continue;
       if (options_.max_range > 0 && (p - origin_w).norm() > options_.max_range) continue;
-      tree_->updateNode(octomap::point3d(p.x(), p.y(), p.z()), true);
+      tree_->updateNode(octomap::point3d(p.x(), p.y(), p.z()), true, /*lazy_eval=*/true);
     }
+    inner_nodes_stale_ = true;
     return;
   }
   octomap::Pointcloud cloud;
@@ -66,8 +79,9 @@ void OccupancyMap::insert(const Eigen::Vector3d& origin_w,
     if (p.allFinite() && (p - origin_w).norm() < kMaxRayLength_m)
       cloud.push_back(p.x(), p.y(), p.z());
   // discretize: one ray per end voxel, which matters for densely sampled lines.
-  tree_->insertPointCloud(cloud, origin, options_.max_range, /*lazy_eval=*/false,
+  tree_->insertPointCloud(cloud, origin, options_.max_range, /*lazy_eval=*/true,
                           /*discretize=*/true);
+  inner_nodes_stale_ = true;
 }
 
 void OccupancyMap::insertKeyframe(const KeyframeLandmarks& keyframe) {
@@ -85,19 +99,19 @@ void OccupancyMap::insertKeyframe(const KeyframeLandmarks& keyframe) {
 }
 
 std::optional<double> OccupancyMap::occupancy(const Eigen::Vector3d& p_w) const {
-  const octomap::OcTreeNode* n = tree_->search(p_w.x(), p_w.y(), p_w.z());
+  const octomap::OcTreeNode* n = tree().search(p_w.x(), p_w.y(), p_w.z());
   if (!n) return std::nullopt;
   return n->getOccupancy();
 }
 
 bool OccupancyMap::isOccupied(const Eigen::Vector3d& p_w) const {
-  const octomap::OcTreeNode* n = tree_->search(p_w.x(), p_w.y(), p_w.z());
-  return n && tree_->isNodeOccupied(n);
+  const octomap::OcTreeNode* n = tree().search(p_w.x(), p_w.y(), p_w.z());
+  return n && tree().isNodeOccupied(n);
 }
 
 bool OccupancyMap::isFree(const Eigen::Vector3d& p_w) const {
-  const octomap::OcTreeNode* n = tree_->search(p_w.x(), p_w.y(), p_w.z());
-  return n && !tree_->isNodeOccupied(n);
+  const octomap::OcTreeNode* n = tree().search(p_w.x(), p_w.y(), p_w.z());
+  return n && !tree().isNodeOccupied(n);
 }
 
 VoxelCounts countVoxels(const octomap::OcTree& tree) {

@@ -1,6 +1,10 @@
 // OccupancyMap: sampled segments become occupied voxels, rays carve free space,
 // the sensor model and range parameters are applied.
 #include <gtest/gtest.h>
+#include <octomap/OcTree.h>
+
+#include <random>
+#include <sstream>
 
 #include "alvio/common/error.h"
 #include "alvio/config/yaml_reader.h"
@@ -94,4 +98,38 @@ TEST(OccupancyMap, OptionsUseOctomapServerNames) {
   const YamlReader bad =
       YamlReader::fromString("mapping:\n  octomap:\n    sensor_model_hit: 0.3\n", "t.yaml");
   EXPECT_THROW(OccupancyMapOptions::load(bad, "mapping.octomap"), Error);
+}
+
+// Insertions are lazy (inner nodes updated when the tree is read): the result must be the
+// tree that OctoMap's eager insertion builds from the same rays.
+TEST(OccupancyMap, LazyInsertionBuildsTheEagerTree) {
+  OccupancyMap map;
+  octomap::OcTree eager(map.options().resolution);
+  eager.setProbHit(map.options().hit);
+  eager.setProbMiss(map.options().miss);
+  eager.setClampingThresMin(map.options().clamp_min);
+  eager.setClampingThresMax(map.options().clamp_max);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int k = 0; k < 30; ++k) {
+    const Vector3d origin(0.1 * k, 0.3 * u(rng), 0.2 * u(rng));
+    std::vector<Vector3d> points;
+    octomap::Pointcloud cloud;
+    for (int i = 0; i < 200; ++i) {
+      // A wall at x = 4 and a floor at z = -1, seen again and again from moving cameras.
+      const Vector3d p = i % 2 ? Vector3d(4.0, 3 * u(rng), u(rng))
+                               : Vector3d(0.1 * k + 2 * u(rng), 2 * u(rng), -1.0);
+      points.push_back(p);
+      cloud.push_back(p.x(), p.y(), p.z());
+    }
+    map.insert(origin, points);
+    eager.insertPointCloud(cloud, octomap::point3d(origin.x(), origin.y(), origin.z()),
+                           map.options().max_range, false, true);
+  }
+  std::ostringstream lazy_bytes, eager_bytes;
+  map.tree().writeBinaryConst(lazy_bytes);
+  eager.writeBinaryConst(eager_bytes);
+  EXPECT_EQ(lazy_bytes.str(), eager_bytes.str());
+  EXPECT_EQ(map.tree().size(), eager.size());
+  EXPECT_GT(map.counts().occupied, 100u);
 }

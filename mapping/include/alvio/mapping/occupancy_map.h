@@ -71,14 +71,22 @@ class OccupancyMap {
   bool isOccupied(const Eigen::Vector3d& p_w) const;
   bool isFree(const Eigen::Vector3d& p_w) const;
 
-  const octomap::OcTree& tree() const { return *tree_; }
-  VoxelCounts counts() const { return countVoxels(*tree_); }
-  std::size_t memoryBytes() const { return tree_->memoryUsage(); }
+  /// The tree with its inner nodes up to date and pruned.
+  const octomap::OcTree& tree() const;
+  VoxelCounts counts() const { return countVoxels(tree()); }
+  std::size_t memoryBytes() const { return tree().memoryUsage(); }
   const OccupancyMapOptions& options() const { return options_; }
 
  private:
+  /// Insertions update the voxels only (OctoMap's lazy evaluation): walking back up the
+  /// tree after every voxel costs more than updating the inner nodes and pruning once,
+  /// when the tree is read. Periodic pruning was measured: each pass over the whole tree
+  /// costs more than it saves, and the unpruned tree is only ~1 % larger.
+  void syncInnerNodes() const;
+
   OccupancyMapOptions options_;
   std::unique_ptr<octomap::OcTree> tree_;
+  mutable bool inner_nodes_stale_ = false;
 };
 
 }  // namespace alvio
