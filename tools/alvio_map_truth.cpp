@@ -57,6 +57,9 @@ int main(int argc, char** argv) {
     std::vector<Segment3> edges;
     for (const sim::SceneEdge& e : scene.scene.edges()) edges.push_back({e.a, e.b});
     const sim::SurfaceDistance surfaces(scene.scene);
+    const SurfaceDistanceFn surface_distance = [&](const Eigen::Vector3d& p) {
+      return surfaces(p);
+    };
 
     const std::vector<MapLine> map_lines = readLinesCsv((run / kLinesCsvFileName).string());
     std::vector<Segment3> lines;
@@ -69,9 +72,8 @@ int main(int argc, char** argv) {
     options.line_angle_tol_deg = args.getDouble("line-angle");
     options.voxel_tolerance_m = args.isSet("voxel-tolerance") ? args.getDouble("voxel-tolerance")
                                                               : 2 * tree->getResolution();
-    const MapTruthEvaluation m = evaluateMapAgainstTruth(
-        lines, tree.get(), traj.alignment, edges,
-        [&](const Eigen::Vector3d& p) { return surfaces(p); }, options);
+    const MapTruthEvaluation m = evaluateMapAgainstTruth(lines, tree.get(), traj.alignment, edges,
+                                                         surface_distance, options);
     const VoxelCounts voxels = countVoxels(*tree);
 
     const nlohmann::json report = {
@@ -137,13 +139,12 @@ int main(int argc, char** argv) {
       for (const MapLine& l : map_lines) {
         const Segment3 s{traj.alignment.apply(l.p0), traj.alignment.apply(l.p1)};
         const LineError e = lineErrorToNearestEdge(s, edges);
-        const double surface =
-            std::max({surfaces(s.p0), surfaces(s.p1), surfaces(0.5 * (s.p0 + s.p1))});
         const LineMapEvaluation one = evaluateLineMap({s}, edges, options.line_distance_tol_m,
                                                       options.line_angle_tol_deg * M_PI / 180.0);
         os << l.id << "," << s.length() << "," << l.observations << "," << l.landmarks << ","
-           << e.edge << "," << e.angle_deg << "," << e.midpoint_distance_m << "," << surface << ","
-           << surfaces(0.5 * (s.p0 + s.p1)) << "," << one.precision << "\n";
+           << e.edge << "," << e.angle_deg << "," << e.midpoint_distance_m << ","
+           << lineSurfaceDistance(s, surface_distance) << "," << surfaces(0.5 * (s.p0 + s.p1))
+           << "," << one.precision << "\n";
       }
       writeFileAtomically(args.get("per-line"), os.str());
     }

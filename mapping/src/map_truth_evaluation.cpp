@@ -37,6 +37,11 @@ LineError lineErrorToNearestEdge(const Segment3& line, const std::vector<Segment
   return out;
 }
 
+double lineSurfaceDistance(const Segment3& line, const SurfaceDistanceFn& surface_distance) {
+  return std::max({surface_distance(line.p0), surface_distance(line.p1),
+                   surface_distance(0.5 * (line.p0 + line.p1))});
+}
+
 LineErrorSummary summariseLineErrors(const std::vector<Segment3>& lines,
                                      const std::vector<Segment3>& true_edges) {
   LineErrorSummary s;
@@ -70,10 +75,8 @@ MapTruthEvaluation evaluateMapAgainstTruth(const std::vector<Segment3>& lines_es
   double total = 0, on_surface = 0;
   for (const Segment3& l : lines) {
     total += l.length();
-    const bool on = surface_distance(l.p0) <= options.line_distance_tol_m &&
-                    surface_distance(l.p1) <= options.line_distance_tol_m &&
-                    surface_distance(0.5 * (l.p0 + l.p1)) <= options.line_distance_tol_m;
-    if (on) on_surface += l.length();
+    if (lineSurfaceDistance(l, surface_distance) <= options.line_distance_tol_m)
+      on_surface += l.length();
   }
   out.line_on_surface_fraction = total > 0 ? on_surface / total : 0;
   if (tree)

@@ -32,6 +32,9 @@ struct LineError {
 
 /// The error of one line against its nearest true edge (see above).
 LineError lineErrorToNearestEdge(const Segment3& line, const std::vector<Segment3>& true_edges);
+/// How far a line strays from the true surfaces: the largest distance of its endpoints and
+/// midpoint to one. A line "lies on a surface" when this is within the line tolerance.
+double lineSurfaceDistance(const Segment3& line, const SurfaceDistanceFn& surface_distance);
 /// Medians and 90th percentiles over `lines`.
 LineErrorSummary summariseLineErrors(const std::vector<Segment3>& lines,
                                      const std::vector<Segment3>& true_edges);
