@@ -107,6 +107,29 @@ TEST(LineDetector, LargerLsdQuantSkipsFaintEdges) {
   EXPECT_EQ(edgesAt(8.0), (std::set<int>{500}));
 }
 
+TEST(LineDetector, FldOnAScaledImageReturnsFullResolutionSegments) {
+  const test::SyntheticLineScene scene(kSize);
+  const cv::Mat image = scene.render(kBars, {0, 0});
+  std::vector<LineSegment> edges;
+  for (const Bar& bar : kBars)
+    for (const LineSegment& e : longEdges(bar, {0, 0})) edges.push_back(e);
+  // Each long edge of a bar is found, as a segment within 2 px of it (FLD's Canny edges are
+  // whole pixels: at half scale a pixel is 2 px of the full image) and at least half as long.
+  for (double scale : {1.0, 0.5}) {
+    LineDetectorOptions o;
+    o.method = "fld";
+    o.fld_scale = scale;
+    const auto lines = LineDetector(o, kSize).detect(image);
+    std::set<std::size_t> found;
+    for (const LineSegment& s : lines)
+      for (std::size_t k = 0; k < edges.size(); ++k)
+        if (edges[k].distanceToLine(s.start) < 2.0 && edges[k].distanceToLine(s.end) < 2.0 &&
+            s.length() > 0.5 * edges[k].length())
+          found.insert(k);
+    EXPECT_EQ(found.size(), edges.size()) << "fld_scale " << scale;
+  }
+}
+
 TEST(LineTracker, TrackedLinesComeFirstUnderTheCap) {
   // With room for 6 lines, the second frame keeps the 6 tracked ones and starts none of the
   // new bar's longer edges.

@@ -65,10 +65,11 @@ const FramePair& framePair() {
   return pair;
 }
 
-void detectLines(benchmark::State& state, const std::string& method) {
+void detectLines(benchmark::State& state, const std::string& method, double fld_scale = 1.0) {
   const FramePair& f = framePair();
   LineDetectorOptions options = config().lines.detector;
   options.method = method;
+  options.fld_scale = fld_scale;
   LineDetector detector(options, f.a.size());
   std::size_t n = 0;
   for (auto _ : state) n = detector.detect(f.a).size();
@@ -80,8 +81,12 @@ void BM_LineDetectionLsd(benchmark::State& state) {
 void BM_LineDetectionFld(benchmark::State& state) {
   detectLines(state, "fld");
 }
+void BM_LineDetectionFldHalfScale(benchmark::State& state) {
+  detectLines(state, "fld", 0.5);
+}
 BENCHMARK(BM_LineDetectionLsd)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_LineDetectionFld)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_LineDetectionFldHalfScale)->Unit(benchmark::kMillisecond);
 
 // Detection + undistortion + tracking, alternating between the two frames so that tracks
 // live on (the steady state of the flow tracker: mostly Type 1 lines).

@@ -14,8 +14,8 @@ LineDetector::LineDetector(const LineDetectorOptions& options, cv::Size image_si
   if (options_.method == "fld")
     // Segments shorter than any we keep are not worth FLD's fitting; no merging (the tracker
     // merges split lines itself, as Type 3).
-    fld_ = cv::ximgproc::createFastLineDetector(static_cast<int>(shortestLength()), 1.41421356f,
-                                                50.0, 50.0, 3, false);
+    fld_ = cv::ximgproc::createFastLineDetector(
+        static_cast<int>(shortestLength() * options_.fld_scale), 1.41421356f, 50.0, 50.0, 3, false);
   else
     lsd_ = cv::createLineSegmentDetector(
         options_.lsd_refine ? cv::LSD_REFINE_STD : cv::LSD_REFINE_NONE, options_.lsd_scale,
@@ -24,7 +24,13 @@ LineDetector::LineDetector(const LineDetectorOptions& options, cv::Size image_si
 
 std::vector<LineSegment> LineDetector::detect(const cv::Mat& gray, const cv::Mat& valid_mask) {
   std::vector<cv::Vec4f> raw;
-  if (fld_)
+  if (fld_ && options_.fld_scale < 1) {
+    cv::resize(gray, scaled_, cv::Size(), options_.fld_scale, options_.fld_scale, cv::INTER_AREA);
+    fld_->detect(scaled_, raw);
+    // Back to full-resolution pixel centres: u = (u_scaled + 0.5) / s - 0.5.
+    const float k = static_cast<float>(1.0 / options_.fld_scale), c = 0.5f * k - 0.5f;
+    for (cv::Vec4f& r : raw) r = cv::Vec4f(r[0] * k + c, r[1] * k + c, r[2] * k + c, r[3] * k + c);
+  } else if (fld_)
     fld_->detect(gray, raw);
   else
     lsd_->detect(gray, raw);

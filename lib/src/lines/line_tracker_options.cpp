@@ -35,6 +35,7 @@ LineDetectorOptions LineDetectorOptions::load(const YamlReader& yaml, const std:
   o.max_lines = yaml.getInt(p + "max_lines", o.max_lines);
   o.max_detections = yaml.getInt(p + "max_detections", o.max_detections);
   o.lsd_scale = yaml.getDouble(p + "lsd_scale", o.lsd_scale);
+  o.fld_scale = yaml.getDouble(p + "fld_scale", o.fld_scale);
   o.lsd_sigma_scale = yaml.getDouble(p + "lsd_sigma_scale", o.lsd_sigma_scale);
   o.lsd_refine = yaml.getBool(p + "lsd_refine", o.lsd_refine);
   o.lsd_quant = yaml.getDouble(p + "lsd_quant", o.lsd_quant);
@@ -53,6 +54,7 @@ void LineDetectorOptions::validate(const std::string& where) const {
   require(max_lines > 0, where, "max_lines", "positive", max_lines);
   require(max_detections >= max_lines, where, "max_detections", ">= max_lines", max_detections);
   require(lsd_scale > 0 && lsd_scale <= 1, where, "lsd_scale", "in (0, 1]", lsd_scale);
+  require(fld_scale > 0 && fld_scale <= 1, where, "fld_scale", "in (0, 1]", fld_scale);
   require(lsd_sigma_scale > 0, where, "lsd_sigma_scale", "positive", lsd_sigma_scale);
   require(lsd_quant > 0, where, "lsd_quant", "positive", lsd_quant);
   require(border_margin_px >= 0, where, "border_margin_px", "non-negative", border_margin_px);

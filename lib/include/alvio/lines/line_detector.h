@@ -33,6 +33,7 @@ class LineDetector {
   double min_length_;
   cv::Ptr<cv::LineSegmentDetector> lsd_;
   cv::Ptr<cv::ximgproc::FastLineDetector> fld_;
+  cv::Mat scaled_;       // FLD's resized input, reused
   cv::Mat source_mask_;  // the valid mask last seen (compared by data pointer)
   cv::Mat eroded_mask_;  // it shrunk by the border margin; empty if it is all valid
 };

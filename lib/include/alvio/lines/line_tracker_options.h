@@ -34,6 +34,9 @@ struct LineDetectorOptions {
   double lsd_scale = 0.5;
   /// LSD's Gaussian sigma factor (sigma = lsd_sigma_scale / lsd_scale).
   double lsd_sigma_scale = 0.6;
+  /// FLD works on the image resized by this factor (area averaging). 0.5 is 3.5x faster than
+  /// LSD at its 0.5, but its flow tracks are a third shorter (docs/benchmarks.md).
+  double fld_scale = 1.0;
   /// LSD_REFINE_STD (true: splits segments at bends) or LSD_REFINE_NONE.
   bool lsd_refine = false;
   /// LSD's bound on the gradient's quantisation error (OpenCV's `quant`): pixels whose
