@@ -125,6 +125,7 @@ LineTrackerOptions LineTrackerOptions::load(const YamlReader& yaml, const std::s
   LineTrackerOptions o;
   const std::string p = keyPrefix(prefix);
   o.tracker = yaml.getString(p + "tracker", o.tracker);
+  o.own_thread = yaml.getBool(p + "own_thread", o.own_thread);
   o.detector = LineDetectorOptions::load(yaml, p + "detector");
   o.flow = FlowLineTrackerOptions::load(yaml, p + "flow");
   o.descriptor = DescriptorLineTrackerOptions::load(yaml, p + "descriptor");

@@ -1,5 +1,7 @@
 #include "alvio/pipeline/front_end.h"
 
+#include <future>
+
 namespace alvio {
 
 FrontEnd::FrontEnd(const Config& config)
@@ -7,15 +9,22 @@ FrontEnd::FrontEnd(const Config& config)
       exposure_(config.points.exposure_jump),
       point_tracker_(config.points, camera_),
       line_tracker_(config.estimator.use_lines ? createLineTracker(config.camera, config.lines)
-                                               : nullptr) {}
+                                               : nullptr),
+      lines_own_thread_(config.lines.own_thread) {}
 
 FeatureFrame FrontEnd::track(const cv::Mat& gray, int64_t t_ns, FrameTiming* timing) {
   const double mean = cv::mean(gray)[0];
   const cv::Mat& image = exposure_.apply(gray, mean, &compensated_);
+  // The two trackers share nothing but the (read-only) image.
+  std::future<LineFrame> lines_done;
+  if (line_tracker_ && lines_own_thread_)
+    lines_done =
+        std::async(std::launch::async, [&] { return line_tracker_->track(image, t_ns * 1e-9); });
   // The frame records the scene's light, not the compensated level.
   FeatureFrame frame = point_tracker_.track(image, t_ns, timing, mean);
   if (line_tracker_) {
-    LineFrame lines = line_tracker_->track(image, t_ns * 1e-9);
+    LineFrame lines =
+        lines_done.valid() ? lines_done.get() : line_tracker_->track(image, t_ns * 1e-9);
     frame.lines = std::move(lines.lines);
     frame.line_stats = lines.stats;
     if (timing) {

@@ -89,6 +89,9 @@ struct DescriptorLineTrackerOptions {
 
 struct LineTrackerOptions {
   std::string tracker = "flow";  ///< "flow" or "descriptor"
+  /// Track lines in a thread of their own, beside the point tracker (FrontEnd). The frames are
+  /// the same either way; on two or more cores a frame's front end finishes sooner.
+  bool own_thread = false;
   LineDetectorOptions detector;
   FlowLineTrackerOptions flow;
   DescriptorLineTrackerOptions descriptor;

@@ -38,6 +38,7 @@ class FrontEnd {
   cv::Mat compensated_;
   PointTracker point_tracker_;
   std::unique_ptr<LineTracker> line_tracker_;  // null when lines are off
+  bool lines_own_thread_;
 };
 
 }  // namespace alvio
