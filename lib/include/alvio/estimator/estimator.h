@@ -207,8 +207,13 @@ class Estimator {
   // Ceres parameter blocks; addresses are stable for the estimator's lifetime.
   std::vector<std::array<double, 7>> para_pose_;
   std::vector<std::array<double, 9>> para_speed_bias_;
-  std::vector<double> para_inv_depth_;
-  std::vector<std::array<double, 4>> para_line_;  // usable lines, in iteration order
+  // Landmarks in one buffer: the usable points' inverse depths, then 4 parameters per usable
+  // line, in iteration order. Ceres orders a group's blocks by address, so one buffer makes
+  // the elimination order (and so the rounding) independent of where the heap put things.
+  std::vector<double> para_landmarks_;
+  std::size_t num_point_params_ = 0;
+  double* inverseDepthBlock(int index) { return &para_landmarks_[index]; }
+  double* lineBlock(std::size_t k) { return &para_landmarks_[num_point_params_ + 4 * k]; }
 
   std::shared_ptr<MarginalizationInfo> last_marginalization_;
   std::vector<double*> last_marginalization_blocks_;

@@ -14,7 +14,7 @@ namespace alvio {
 enum class LineLandmarkStatus {
   kNew,           ///< observed, not yet triangulated
   kTriangulated,  ///< has an initial 3D line
-  kOptimised,     ///< refined in the sliding window
+  kOptimised,     ///< refined over its whole track, when it left the window
   kOutlier,       ///< rejected (large residuals); kept only so its ID is not reused
 };
 const char* toString(LineLandmarkStatus status);
