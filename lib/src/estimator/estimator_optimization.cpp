@@ -107,6 +107,10 @@ void Estimator::statesToParameters() {
   }
 }
 
+double* Estimator::lineBlock(std::size_t k) {
+  return &para_landmarks_[num_point_params_ + OrthonormalLine::kParameterSize * k];
+}
+
 void Estimator::parametersToStates() {
   // The window is only constrained up to a yaw and a translation (plus the prior): keep the
   // oldest keyframe's yaw and position where they were, so the output does not wander.
@@ -131,11 +135,9 @@ void Estimator::parametersToStates() {
   }
   points_.setInverseDepths(
       Eigen::Map<const Eigen::VectorXd>(para_landmarks_.data(), num_point_params_));
-  // The lines' optimised parameters are not kept: each solve starts again from the
-  // triangulation. Keeping them (moved with the re-anchoring) was measured worse: ATE on
-  // sim_MH_01 0.0341 -> 0.0392 m, sim_MH_05 0.0829 -> 0.0879 m, and map line precision on
-  // sim_MH_01 43.9 -> 35.5 % (a likely cause, not verified: lines seen over a short baseline
-  // drift, window after window, along directions their few observations hardly constrain).
+  // The lines' optimised parameters are not kept: each solve restarts them from the
+  // triangulation. Keeping them was measured worse, in ATE and in the map
+  // (docs/benchmarks.md, seventh session).
 }
 
 void Estimator::optimize(FrameTiming* timing, int max_iterations) {

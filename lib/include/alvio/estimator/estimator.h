@@ -213,7 +213,7 @@ class Estimator {
   std::vector<double> para_landmarks_;
   std::size_t num_point_params_ = 0;
   double* inverseDepthBlock(int index) { return &para_landmarks_[index]; }
-  double* lineBlock(std::size_t k) { return &para_landmarks_[num_point_params_ + 4 * k]; }
+  double* lineBlock(std::size_t k);
 
   std::shared_ptr<MarginalizationInfo> last_marginalization_;
   std::vector<double*> last_marginalization_blocks_;
