@@ -9,14 +9,7 @@ import json
 import statistics
 import sys
 
-
-def percentile(values, p):
-    s = sorted(values)
-    if not s:
-        return float("nan")
-    k = (len(s) - 1) * p / 100.0
-    lo, hi = int(k), min(int(k) + 1, len(s) - 1)
-    return s[lo] + (k - lo) * (s[hi] - s[lo])
+from bench import percentile  # scripts/bench.py: linear interpolation over sorted values
 
 
 def main():
@@ -38,7 +31,7 @@ def main():
     if not statuses:
         sys.exit(f"latency.py: {args.bag}: no status messages")
     tracking = [m for m in statuses if m.state == "tracking"]
-    latency = [m.latency_ms for m in tracking if m.latency_ms >= 0]
+    latency = sorted(m.latency_ms for m in tracking if m.latency_ms >= 0)
     frontend = [m.frontend_ms for m in tracking]
     estimator = [m.estimator_ms for m in tracking]
     last = statuses[-1]
