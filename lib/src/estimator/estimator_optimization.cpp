@@ -55,7 +55,9 @@ bool Estimator::lineSelected(const LineLandmark& l) const {
 void Estimator::updateWeights() {
   stats_ = OptimizationStats();
   double track_p = 0, track_l = 0;
-  int point_residuals = 0, line_residuals = 0;  // of the selected features, as optimize() adds
+  // Residuals of the selected features: what optimize() adds.
+  int& point_residuals = stats_.point_residuals;
+  int& line_residuals = stats_.line_residuals;
   for (const auto& [id, l] : points_.landmarks()) {
     if (!l.usable(W_)) continue;
     ++stats_.points_tracked;
@@ -183,7 +185,7 @@ void Estimator::optimize(FrameTiming* timing, int max_iterations) {
                              para_speed_bias_[j].data());
   }
   const double sqrt_info = point_scale_ * camera_.intrinsics[0] / options_.point_sigma_px;
-  int index = -1, residuals = 0;
+  int index = -1;
   for (const auto& [id, l] : points_.landmarks()) {
     if (!l.usable(W_)) continue;
     ++index;
@@ -196,12 +198,9 @@ void Estimator::optimize(FrameTiming* timing, int max_iterations) {
       problem.AddResidualBlock(
           new PointProjectionFactor(obs_i, l.sightings[k].xy1.head<2>(), T_b_c_, sqrt_info),
           loss.get(), para_pose_[i].data(), para_pose_[j].data(), inverseDepthBlock(index));
-      ++residuals;
     }
   }
-  last_point_residuals_ = residuals;
   // Lines: one factor per window observation, on the observing frame's pose.
-  int line_residuals = 0;
   if (options_.use_lines) {
     auto* line_manifold = new OrthonormalLineManifold();  // owned by the problem
     const double line_sqrt_info = line_scale_ * camera_.intrinsics[0] / options_.line_sigma_px;
@@ -218,11 +217,9 @@ void Estimator::optimize(FrameTiming* timing, int max_iterations) {
         problem.AddResidualBlock(
             new LineProjectionFactor(obs.start_norm, obs.end_norm, T_b_c_, line_sqrt_info),
             loss.get(), para_pose_[slot.at(ns)].data(), line_block);
-        ++line_residuals;
       }
     }
   }
-  last_line_residuals_ = line_residuals;
 
   ceres::Solver::Options options;
   options.linear_solver_type = ceres::DENSE_SCHUR;
@@ -232,10 +229,10 @@ void Estimator::optimize(FrameTiming* timing, int max_iterations) {
   options.num_threads = options_.num_threads;
   ceres::Solver::Summary summary;
   ceres::Solve(options, &problem, &summary);
-  last_iterations_ = static_cast<int>(summary.iterations.size());
-  stats_.iterations = last_iterations_;
-  stats_.point_residuals = last_point_residuals_;
-  stats_.line_residuals = last_line_residuals_;
+  stats_.iterations = static_cast<int>(summary.iterations.size());
+  stats_.solver_ms = 1e3 * summary.total_time_in_seconds;
+  stats_.linear_solver_ms = 1e3 * summary.linear_solver_time_in_seconds;
+  stats_.jacobian_ms = 1e3 * summary.jacobian_evaluation_time_in_seconds;
   parametersToStates();
   removeReprojectionOutliers();
   if (options_.use_lines) {

@@ -79,6 +79,8 @@ struct OptimizationStats {
   int point_residuals = 0, line_residuals = 0;
   double w_p = 0.5, w_l = 0.5, alpha = 1.0, M_p = 0, M_l = 0;
   int iterations = 0;
+  /// Ceres's own clock for the solve: total, and its linear solver and Jacobian parts.
+  double solver_ms = 0, linear_solver_ms = 0, jacobian_ms = 0;
 };
 
 /// Something a user should know about: initialisation, a reset, why it waits.
@@ -129,9 +131,9 @@ class Estimator {
   /// Events since the last call (moved out).
   std::vector<EstimatorEvent> takeEvents();
   /// Residual blocks and iterations of the last optimisation (diagnostics).
-  int lastIterations() const { return last_iterations_; }
-  int lastPointResiduals() const { return last_point_residuals_; }
-  int lastLineResiduals() const { return last_line_residuals_; }
+  int lastIterations() const { return stats_.iterations; }
+  int lastPointResiduals() const { return stats_.point_residuals; }
+  int lastLineResiduals() const { return stats_.line_residuals; }
   const OptimizationStats& lastOptimizationStats() const { return stats_; }
   const PointLandmarks& points() const { return points_; }
   const LineLandmarks& lines() const { return lines_; }
@@ -252,7 +254,6 @@ class Estimator {
   bool settling_ = false;  ///< initialised, no output until the scale settles
   double settle_start_ = 0;
   std::map<int64_t, Eigen::Vector3d> settling_positions_;  ///< by frame time
-  int last_iterations_ = 0, last_point_residuals_ = 0, last_line_residuals_ = 0;
   OptimizationStats stats_;
   double point_scale_ = 1.0, line_scale_ = 1.0;  // residual scales from the adaptive weights
   std::vector<EstimatorEvent> events_;
