@@ -105,13 +105,15 @@ std::optional<double> OccupancyMap::occupancy(const Eigen::Vector3d& p_w) const 
 }
 
 bool OccupancyMap::isOccupied(const Eigen::Vector3d& p_w) const {
-  const octomap::OcTreeNode* n = tree().search(p_w.x(), p_w.y(), p_w.z());
-  return n && tree().isNodeOccupied(n);
+  const octomap::OcTree& t = tree();
+  const octomap::OcTreeNode* n = t.search(p_w.x(), p_w.y(), p_w.z());
+  return n && t.isNodeOccupied(n);
 }
 
 bool OccupancyMap::isFree(const Eigen::Vector3d& p_w) const {
-  const octomap::OcTreeNode* n = tree().search(p_w.x(), p_w.y(), p_w.z());
-  return n && !tree().isNodeOccupied(n);
+  const octomap::OcTree& t = tree();
+  const octomap::OcTreeNode* n = t.search(p_w.x(), p_w.y(), p_w.z());
+  return n && !t.isNodeOccupied(n);
 }
 
 VoxelCounts countVoxels(const octomap::OcTree& tree) {
