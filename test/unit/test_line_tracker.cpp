@@ -107,6 +107,44 @@ TEST(LineDetector, LargerLsdQuantSkipsFaintEdges) {
   EXPECT_EQ(edgesAt(8.0), (std::set<int>{500}));
 }
 
+TEST(LineDetector, LsdOnAScaledImageFindsStepEdgesWhereTheyAre) {
+  // A bright quadrant x > ex, y > ey, pixels shaded by the area they cover (pixel u spans
+  // [u - 0.5, u + 0.5]), at ten sub-pixel positions. Before the scale shift, lsd_scale 0.5
+  // put every edge 0.5 px up and left.
+  for (double scale : {1.0, 0.5}) {
+    double sum_x = 0, sum_y = 0;
+    int n_x = 0, n_y = 0;
+    for (int k = 0; k < 10; ++k) {
+      const double ex = 300 + 0.1 * k, ey = 200.37 + 0.1 * k;
+      cv::Mat image(kSize, CV_8UC1);
+      for (int v = 0; v < image.rows; ++v)
+        for (int u = 0; u < image.cols; ++u) {
+          const double cover =
+              std::clamp(u + 0.5 - ex, 0.0, 1.0) * std::clamp(v + 0.5 - ey, 0.0, 1.0);
+          image.at<uint8_t>(v, u) = cv::saturate_cast<uint8_t>(60 + 140 * cover);
+        }
+      LineDetectorOptions o;
+      o.lsd_scale = scale;
+      for (const LineSegment& s : LineDetector(o, kSize).detect(image)) {
+        const Eigen::Vector2d d = s.end - s.start;
+        if (std::abs(d.x()) < 1 && s.length() > 100) {
+          EXPECT_NEAR(s.midpoint().x(), ex, 0.2) << "scale " << scale;
+          sum_x += s.midpoint().x() - ex;
+          ++n_x;
+        } else if (std::abs(d.y()) < 1 && s.length() > 100) {
+          EXPECT_NEAR(s.midpoint().y(), ey, 0.2) << "scale " << scale;
+          sum_y += s.midpoint().y() - ey;
+          ++n_y;
+        }
+      }
+    }
+    ASSERT_EQ(n_x, 10) << "scale " << scale;
+    ASSERT_EQ(n_y, 10) << "scale " << scale;
+    EXPECT_NEAR(sum_x / n_x, 0.0, 0.05) << "mean x offset at scale " << scale;
+    EXPECT_NEAR(sum_y / n_y, 0.0, 0.05) << "mean y offset at scale " << scale;
+  }
+}
+
 TEST(LineDetector, FldOnAScaledImageReturnsFullResolutionSegments) {
   const test::SyntheticLineScene scene(kSize);
   const cv::Mat image = scene.render(kBars, {0, 0});

@@ -22,18 +22,33 @@ LineDetector::LineDetector(const LineDetectorOptions& options, cv::Size image_si
         options_.lsd_sigma_scale, options_.lsd_quant);
 }
 
+namespace {
+// A coordinate u_s of an image scaled by s, in pixel-centre convention, is u = (u_s + 0.5) / s
+// - 0.5 in the full image: u_s / s plus this shift.
+float scaleShift(double s) {
+  return static_cast<float>(0.5 / s - 0.5);
+}
+void shift(std::vector<cv::Vec4f>* raw, float c) {
+  for (cv::Vec4f& r : *raw) r += cv::Vec4f(c, c, c, c);
+}
+}  // namespace
+
 std::vector<LineSegment> LineDetector::detect(const cv::Mat& gray, const cv::Mat& valid_mask) {
   std::vector<cv::Vec4f> raw;
   if (fld_ && options_.fld_scale < 1) {
     cv::resize(gray, scaled_, cv::Size(), options_.fld_scale, options_.fld_scale, cv::INTER_AREA);
     fld_->detect(scaled_, raw);
-    // Back to full-resolution pixel centres: u = (u_scaled + 0.5) / s - 0.5.
-    const float k = static_cast<float>(1.0 / options_.fld_scale), c = 0.5f * k - 0.5f;
-    for (cv::Vec4f& r : raw) r = cv::Vec4f(r[0] * k + c, r[1] * k + c, r[2] * k + c, r[3] * k + c);
-  } else if (fld_)
+    const float k = static_cast<float>(1.0 / options_.fld_scale);
+    for (cv::Vec4f& r : raw) r *= k;
+    shift(&raw, scaleShift(options_.fld_scale));
+  } else if (fld_) {
     fld_->detect(gray, raw);
-  else
+  } else {
+    // OpenCV's LSD returns u_s / s for a scaled run: without the shift every segment sat
+    // 0.5 px up and left of its edge at lsd_scale 0.5 (test_line_tracker).
     lsd_->detect(gray, raw);
+    if (options_.lsd_scale < 1) shift(&raw, scaleShift(options_.lsd_scale));
+  }
 
   // The mask is the undistorter's, the same every frame: prepare it once.
   if (valid_mask.data != source_mask_.data) {
