@@ -151,8 +151,8 @@ Eigen::Vector3d fromPoint(const geometry_msgs::Point& m) {
 }
 }  // namespace
 
-void toMsg(const alvio::KeyframeLandmarks& keyframe, const std::vector<double>& line_std_deg,
-           uint8_t kind, const std_msgs::Header& header, alvio::MapKeyframe* msg) {
+void toMsg(const alvio::KeyframeLandmarks& keyframe, uint8_t kind, const std_msgs::Header& header,
+           alvio::MapKeyframe* msg) {
   msg->header = header;
   msg->kind = kind;
   msg->camera_pose = toPose(keyframe.T_w_c);
@@ -170,20 +170,19 @@ void toMsg(const alvio::KeyframeLandmarks& keyframe, const std::vector<double>& 
     m.start = toPoint(l.p0_w);
     m.end = toPoint(l.p1_w);
     m.observations = l.observations;
-    m.direction_std_deg = i < line_std_deg.size() ? line_std_deg[i] : -1.0;
+    m.direction_std_deg = l.direction_std_deg;
   }
 }
 
-alvio::KeyframeLandmarks fromMsg(const alvio::MapKeyframe& msg, double max_direction_std_deg) {
+alvio::KeyframeLandmarks fromMsg(const alvio::MapKeyframe& msg) {
   alvio::KeyframeLandmarks kf;
   kf.t = msg.header.stamp.toSec();
   kf.T_w_c = fromPose(msg.camera_pose);
   for (const auto& p : msg.points)
     kf.points.push_back({p.id, fromPoint(p.position), p.parallax_deg});
-  for (const auto& l : msg.lines) {
-    if (l.direction_std_deg < 0 || l.direction_std_deg > max_direction_std_deg) continue;
-    kf.lines.push_back({l.id, fromPoint(l.start), fromPoint(l.end), l.observations});
-  }
+  for (const auto& l : msg.lines)
+    kf.lines.push_back(
+        {l.id, fromPoint(l.start), fromPoint(l.end), l.observations, l.direction_std_deg});
   return kf;
 }
 

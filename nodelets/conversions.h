@@ -40,12 +40,11 @@ geometry_msgs::Pose toPose(const Eigen::Vector3d& p, const Eigen::Quaterniond& q
 geometry_msgs::Pose toPose(const Eigen::Isometry3d& T);
 Eigen::Isometry3d fromPose(const geometry_msgs::Pose& pose);
 
-/// Keyframe landmarks for the map, lines with their direction uncertainty.
-void toMsg(const alvio::KeyframeLandmarks& keyframe, const std::vector<double>& line_std_deg,
-           uint8_t kind, const std_msgs::Header& header, alvio::MapKeyframe* msg);
-/// The map's input; lines whose direction is unknown or less certain than
-/// `max_direction_std_deg` are left out (as the offline runner's MapObserver does).
-alvio::KeyframeLandmarks fromMsg(const alvio::MapKeyframe& msg, double max_direction_std_deg);
+/// Keyframe landmarks for the map, lines with their direction uncertainty (the map's
+/// MapBuilder decides which to keep).
+void toMsg(const alvio::KeyframeLandmarks& keyframe, uint8_t kind, const std_msgs::Header& header,
+           alvio::MapKeyframe* msg);
+alvio::KeyframeLandmarks fromMsg(const alvio::MapKeyframe& msg);
 
 /// An x, y, z (float32) cloud.
 void toCloud(const std::vector<Eigen::Vector3d>& points, const std_msgs::Header& header,

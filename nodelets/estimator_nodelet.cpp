@@ -358,28 +358,20 @@ class EstimatorNodelet : public GuardedNodelet {
 
   // What the offline runner's MapObserver feeds the map: the points anchored in the keyframe
   // leaving the window, and the lines retiring from it (all of them, with their direction
-  // uncertainty: the mapping nodelet applies its own threshold).
+  // uncertainty: the map applies its own threshold).
   void publishMapInput(const alvio::BodyState& state, const alvio::LineSegments3& retired) {
-    if (auto keyframe = feed_->poll(*estimator_)) publishKeyframe(*keyframe, {}, 0);
-    if (retired.empty()) return;
-    alvio::KeyframeLandmarks lines;
-    lines.t = state.t;
-    lines.T_w_c = Eigen::Translation3d(state.p) * state.q * T_b_c_;
-    std::vector<double> std_deg;
-    for (const auto& l : retired) {
-      lines.lines.push_back({l.id, l.start, l.end, l.observations});
-      std_deg.push_back(l.direction_std_deg);
-    }
-    publishKeyframe(lines, std_deg, alvio::MapKeyframe::RETIRED_LINES);
+    if (auto keyframe = feed_->poll(*estimator_)) publishKeyframe(*keyframe, 0);
+    if (!retired.empty())
+      publishKeyframe(alvio::retiredLinesKeyframe(state, T_b_c_, retired),
+                      alvio::MapKeyframe::RETIRED_LINES);
   }
 
-  void publishKeyframe(const alvio::KeyframeLandmarks& keyframe, const std::vector<double>& std_deg,
-                       uint8_t kind) {
+  void publishKeyframe(const alvio::KeyframeLandmarks& keyframe, uint8_t kind) {
     std_msgs::Header header;
     header.stamp.fromSec(keyframe.t);
     header.frame_id = world_frame_;
     auto msg = boost::make_shared<alvio::MapKeyframe>();
-    toMsg(keyframe, std_deg, kind, header, msg.get());
+    toMsg(keyframe, kind, header, msg.get());
     keyframes_pub_.publish(msg);
   }
 
@@ -388,7 +380,7 @@ class EstimatorNodelet : public GuardedNodelet {
   void flushWindowToMap() {
     const auto keyframes = feed_->flush(*estimator_);
     for (const auto& keyframe : keyframes)
-      publishKeyframe(keyframe, {}, alvio::MapKeyframe::KEYFRAME_POINTS);
+      publishKeyframe(keyframe, alvio::MapKeyframe::KEYFRAME_POINTS);
     flushed_ = true;
     if (!keyframes.empty())
       NODELET_INFO(

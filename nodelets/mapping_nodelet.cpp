@@ -66,7 +66,7 @@ class MappingNodelet : public GuardedNodelet {
     // Keyframes leave the estimator's window well after their frame's odometry, so only the
     // odometry tells a clock jump; a keyframe far ahead of it is the old run's.
     if (alvio::clockJumpedBack(newest_ns_, toNs(msg->header.stamp))) return;
-    map_->addKeyframe(fromMsg(*msg, options_.max_line_direction_std_deg));
+    map_->addKeyframe(fromMsg(*msg));
     changed_since_publish_ = changed_since_save_ = true;
   }
 

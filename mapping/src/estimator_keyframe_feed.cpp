@@ -40,6 +40,16 @@ KeyframeLandmarks EstimatorKeyframeFeed::keyframe(const Estimator& estimator, in
   return kf;
 }
 
+KeyframeLandmarks retiredLinesKeyframe(const BodyState& state, const Eigen::Isometry3d& T_b_c,
+                                       const LineSegments3& retired) {
+  KeyframeLandmarks kf;
+  kf.t = state.t;
+  kf.T_w_c = Eigen::Translation3d(state.p) * state.q * T_b_c;
+  for (const LineSegment3& l : retired)
+    kf.lines.push_back({l.id, l.start, l.end, l.observations, l.direction_std_deg});
+  return kf;
+}
+
 std::optional<KeyframeLandmarks> EstimatorKeyframeFeed::poll(const Estimator& estimator) {
   if (estimator.status() != EstimatorStatus::kTracking) return std::nullopt;
   const auto window = estimator.windowStates();

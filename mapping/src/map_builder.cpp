@@ -51,10 +51,16 @@ MapBuilder::MapBuilder(const MappingOptions& options)
     : options_(options), lines_(options.lines), occupancy_(options.octomap) {}
 
 void MapBuilder::addKeyframe(const KeyframeLandmarks& keyframe) {
+  KeyframeLandmarks kept = keyframe;
+  kept.lines.clear();
+  for (const LandmarkSegment& l : keyframe.lines)
+    if (l.direction_std_deg >= 0 && l.direction_std_deg <= options_.max_line_direction_std_deg)
+      kept.lines.push_back(l);
+  // A report of retiring lines none of which is certain enough brings nothing.
+  if (keyframe.points.empty() && kept.lines.empty()) return;
   ++keyframes_;
   lines_.beginKeyframe();
   const Eigen::Vector3d camera = keyframe.T_w_c.translation();
-  KeyframeLandmarks kept = keyframe;
   kept.points.clear();
   for (const LandmarkPoint& p : keyframe.points) {
     if (!p.p_w.allFinite()) continue;
@@ -62,7 +68,7 @@ void MapBuilder::addKeyframe(const KeyframeLandmarks& keyframe) {
     points_[p.id] = p.p_w;
     kept.points.push_back(p);
   }
-  for (const LandmarkSegment& l : keyframe.lines)
+  for (const LandmarkSegment& l : kept.lines)
     lines_.addSegment(l.id, l.p0_w, l.p1_w, l.observations, camera);
   occupancy_.insertKeyframe(kept);
 }

@@ -7,7 +7,7 @@
 namespace alvio {
 
 MapObserver::MapObserver(const MappingOptions& options, const Eigen::Isometry3d& T_b_c)
-    : options_(options), T_b_c_(T_b_c), map_(options), feed_(T_b_c) {}
+    : T_b_c_(T_b_c), map_(options), feed_(T_b_c) {}
 
 void MapObserver::onStart(const RunInfo& info) {
   out_dir_ = info.out_dir;
@@ -19,17 +19,9 @@ void MapObserver::onFrame(const FrameView& frame) {
   if (!out.has_pose) return;
   map_.addTrajectoryPose({out.state.t, out.state.p, out.state.q});
   if (auto keyframe = feed_.poll(frame.pipeline.estimator())) map_.addKeyframe(*keyframe);
-  if (out.retired_lines.empty()) return;
   // Retired lines enter the map seen from the current camera.
-  KeyframeLandmarks lines;
-  lines.t = out.state.t;
-  lines.T_w_c = Eigen::Translation3d(out.state.p) * out.state.q * T_b_c_;
-  for (const auto& l : out.retired_lines) {
-    if (l.direction_std_deg < 0 || l.direction_std_deg > options_.max_line_direction_std_deg)
-      continue;
-    lines.lines.push_back({l.id, l.start, l.end, l.observations});
-  }
-  if (!lines.lines.empty()) map_.addKeyframe(lines);
+  if (!out.retired_lines.empty())
+    map_.addKeyframe(retiredLinesKeyframe(out.state, T_b_c_, out.retired_lines));
 }
 
 void MapObserver::onFinish(const RunResult&) {

@@ -91,6 +91,27 @@ TEST(MapBuilder, PointsSeenWithTooLittleParallaxStayOut) {
   EXPECT_TRUE(map.occupancyMap().isOccupied({0, 0, 2}));
 }
 
+TEST(MapBuilder, LinesOfUncertainOrUnknownDirectionStayOut) {
+  MappingOptions o;
+  o.max_line_direction_std_deg = 2.0;
+  MapBuilder map(o);
+  KeyframeLandmarks kf;
+  kf.lines = {{5, {0, 0, 1}, {2, 0, 1}, 6, 0.5},
+              {6, {0, 1, 1}, {0, 3, 1}, 9, 3.0},    // too uncertain
+              {7, {1, 1, 2}, {3, 1, 2}, 9, -1.0}};  // not computed
+  map.addKeyframe(kf);
+  EXPECT_EQ(map.summary().lines, 1u);
+  EXPECT_EQ(map.summary().keyframes, 1u);
+  EXPECT_TRUE(map.occupancyMap().isOccupied({1, 0, 1}));
+  EXPECT_FALSE(map.occupancyMap().isOccupied({0, 2, 1}));
+  EXPECT_FALSE(map.occupancyMap().isOccupied({2, 1, 2}));
+  // A report of retiring lines that all stay out is not a keyframe for the map.
+  kf.lines = {{8, {0, 0, 3}, {2, 0, 3}, 6, 2.5}};
+  map.addKeyframe(kf);
+  EXPECT_EQ(map.summary().keyframes, 1u);
+  EXPECT_EQ(map.summary().lines, 1u);
+}
+
 TEST(EstimatorKeyframeFeed, ReportsOldestKeyframeLandmarksOnce) {
   const Config c = Config::load(test::sourcePath("config/euroc.yaml"));
   test::ScenarioOptions so;

@@ -133,25 +133,30 @@ TEST(RosMessages, FeatureFrameSurvivesTheMessage) {
   EXPECT_DOUBLE_EQ(shared.features.stats.total_ms, 10.75);
 }
 
-TEST(RosMessages, MapKeyframeFiltersLinesByDirectionUncertainty) {
+TEST(RosMessages, MapKeyframeCarriesLineDirectionUncertainty) {
   alvio::KeyframeLandmarks kf;
   kf.t = 1600000002.5;
   kf.T_w_c = Eigen::Translation3d(1, 2, 3) * Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ());
   kf.points = {{1, {1, 1, 1}}, {2, {2, 2, 2}}};
-  kf.lines = {
-      {5, {0, 0, 0}, {1, 0, 0}, 6}, {6, {0, 0, 1}, {0, 1, 1}, 9}, {7, {0, 0, 2}, {1, 1, 2}, 3}};
+  kf.lines = {{5, {0, 0, 0}, {1, 0, 0}, 6, 0.5},
+              {6, {0, 0, 1}, {0, 1, 1}, 9, 3.0},
+              {7, {0, 0, 2}, {1, 1, 2}, 3, -1.0}};
   std_msgs::Header header;
   header.stamp.fromSec(kf.t);
   alvio::MapKeyframe msg;
-  toMsg(kf, {0.5, 3.0, -1.0}, alvio::MapKeyframe::RETIRED_LINES, header, &msg);
-  const alvio::KeyframeLandmarks back = fromMsg(msg, 2.0);
+  toMsg(kf, alvio::MapKeyframe::RETIRED_LINES, header, &msg);
+  const alvio::KeyframeLandmarks back = fromMsg(msg);
   EXPECT_NEAR(back.t, kf.t, 1e-6);
   EXPECT_TRUE(back.T_w_c.isApprox(kf.T_w_c, 1e-12));
   ASSERT_EQ(back.points.size(), 2u);
   EXPECT_EQ(back.points[1].p_w, Eigen::Vector3d(2, 2, 2));
-  ASSERT_EQ(back.lines.size(), 1u) << "too uncertain (3 deg) and unknown (-1) lines stay out";
-  EXPECT_EQ(back.lines[0].id, 5);
-  EXPECT_EQ(back.lines[0].observations, 6);
+  ASSERT_EQ(back.lines.size(), 3u);
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(back.lines[i].id, kf.lines[i].id);
+    EXPECT_EQ(back.lines[i].observations, kf.lines[i].observations);
+    EXPECT_EQ(back.lines[i].p1_w, kf.lines[i].p1_w);
+    EXPECT_EQ(back.lines[i].direction_std_deg, kf.lines[i].direction_std_deg);
+  }
 }
 
 TEST(RosMessages, CloudsAndLineListsRoundTrip) {

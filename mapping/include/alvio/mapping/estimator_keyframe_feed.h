@@ -40,4 +40,9 @@ class EstimatorKeyframeFeed {
   double last_oldest_t_ = -1;
 };
 
+/// Lines retiring from the window (Estimator::takeRetiredLines) as the map's input, seen
+/// from the camera of body state `state`, each with its direction uncertainty.
+KeyframeLandmarks retiredLinesKeyframe(const BodyState& state, const Eigen::Isometry3d& T_b_c,
+                                       const LineSegments3& retired);
+
 }  // namespace alvio

@@ -28,6 +28,10 @@ struct LandmarkSegment {
   Eigen::Vector3d p0_w = Eigen::Vector3d::Zero();
   Eigen::Vector3d p1_w = Eigen::Vector3d::Zero();
   int observations = 1;
+  /// 1-sigma uncertainty of the line's direction [deg], from the estimator; negative: it
+  /// could not be computed. The map keeps only lines below MappingOptions'
+  /// max_line_direction_std_deg (0, the default, always passes).
+  double direction_std_deg = 0;
 };
 
 struct KeyframeLandmarks {

@@ -64,7 +64,9 @@ class MapBuilder {
   explicit MapBuilder(const MappingOptions& options = MappingOptions());
 
   /// Points update their landmark (latest position by ID) and go into the occupancy tree
-  /// with the lines; lines go into the line map.
+  /// with the lines; lines go into the line map. Points with too little parallax and lines
+  /// with too uncertain (or unknown) a direction are left out, whichever path (offline
+  /// runner or nodelet) brings them.
   void addKeyframe(const KeyframeLandmarks& keyframe);
   /// A body pose T_w_b of the trajectory (drawn in the scene).
   void addTrajectoryPose(const StampedPose& T_w_b);

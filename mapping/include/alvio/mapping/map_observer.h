@@ -28,7 +28,6 @@ class MapObserver : public RunObserver {
   const MapFilePaths& files() const { return files_; }
 
  private:
-  MappingOptions options_;
   Eigen::Isometry3d T_b_c_;
   MapBuilder map_;
   EstimatorKeyframeFeed feed_;
