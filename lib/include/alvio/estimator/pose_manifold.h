@@ -38,10 +38,17 @@ inline Eigen::Matrix<double, 4, 3> quaternionPlusJacobian(const Eigen::Quaternio
 /// Ambient Jacobian (N x 4, w.r.t. qx qy qz qw) from a Jacobian w.r.t. a right-perturbation
 /// rotation vector (N x 3). EigenQuaternionManifold's delta is a left half-angle vector:
 /// R Exp(theta) = Exp(2 delta) R, so theta = 2 R^T delta.
+/// `R` is q's rotation matrix, for callers that have it already.
+template <int N>
+Eigen::Matrix<double, N, 4> rightRotationJacobianToQuaternion(
+    const Eigen::Matrix<double, N, 3>& J_theta, const Eigen::Quaterniond& q,
+    const Eigen::Matrix3d& R) {
+  return 2.0 * J_theta * R.transpose() * quaternionPlusJacobian(q).transpose();
+}
 template <int N>
 Eigen::Matrix<double, N, 4> rightRotationJacobianToQuaternion(
     const Eigen::Matrix<double, N, 3>& J_theta, const Eigen::Quaterniond& q) {
-  return 2.0 * J_theta * q.toRotationMatrix().transpose() * quaternionPlusJacobian(q).transpose();
+  return rightRotationJacobianToQuaternion<N>(J_theta, q, q.toRotationMatrix());
 }
 
 /// d(Plus(x, delta))/d(delta) at delta = 0 of the whole pose manifold (7 x 6).

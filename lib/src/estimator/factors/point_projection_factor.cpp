@@ -38,23 +38,26 @@ bool PointProjectionFactor::Evaluate(double const* const* parameters, double* re
   Eigen::Matrix<double, 2, 3> reduce;
   reduce << 1.0 / z, 0, -p_cj.x() / (z * z), 0, 1.0 / z, -p_cj.y() / (z * z);
   reduce *= sqrt_info_;
-  const Eigen::Matrix3d R_c_b = R_b_c_.transpose();
+  // d r / d p_w and d r / d p_bi, shared by the blocks.
+  const Eigen::Matrix<double, 2, 3> reduce_c_b = reduce * R_b_c_.transpose();
+  const Eigen::Matrix<double, 2, 3> d_p_w = reduce_c_b * Rj.transpose();
+  const Eigen::Matrix<double, 2, 3> d_p_bi = d_p_w * Ri;
 
   if (jacobians[0]) {
     Eigen::Map<Eigen::Matrix<double, 2, 7, Eigen::RowMajor>> J(jacobians[0]);
-    J.leftCols<3>() = reduce * R_c_b * Rj.transpose();
-    const Eigen::Matrix<double, 2, 3> J_theta = reduce * R_c_b * Rj.transpose() * Ri * -skew(p_bi);
-    J.rightCols<4>() = rightRotationJacobianToQuaternion<2>(J_theta, Qi);
+    J.leftCols<3>() = d_p_w;
+    const Eigen::Matrix<double, 2, 3> J_theta = d_p_bi * -skew(p_bi);
+    J.rightCols<4>() = rightRotationJacobianToQuaternion<2>(J_theta, Qi, Ri);
   }
   if (jacobians[1]) {
     Eigen::Map<Eigen::Matrix<double, 2, 7, Eigen::RowMajor>> J(jacobians[1]);
-    J.leftCols<3>() = reduce * R_c_b * -Rj.transpose();
-    const Eigen::Matrix<double, 2, 3> J_theta = reduce * R_c_b * skew(p_bj);
-    J.rightCols<4>() = rightRotationJacobianToQuaternion<2>(J_theta, Qj);
+    J.leftCols<3>() = -d_p_w;
+    const Eigen::Matrix<double, 2, 3> J_theta = reduce_c_b * skew(p_bj);
+    J.rightCols<4>() = rightRotationJacobianToQuaternion<2>(J_theta, Qj, Rj);
   }
   if (jacobians[2]) {
     Eigen::Map<Eigen::Vector2d> J(jacobians[2]);
-    J = reduce * R_c_b * Rj.transpose() * Ri * R_b_c_ * pts_i_ * (-1.0 / (inv_depth * inv_depth));
+    J = d_p_bi * R_b_c_ * pts_i_ * (-1.0 / (inv_depth * inv_depth));
   }
   return true;
 }
