@@ -230,6 +230,7 @@ void Estimator::optimize(FrameTiming* timing, int max_iterations) {
   ceres::Solver::Summary summary;
   ceres::Solve(options, &problem, &summary);
   stats_.iterations = static_cast<int>(summary.iterations.size());
+  stats_.unsuccessful_steps = summary.num_unsuccessful_steps;
   stats_.solver_ms = 1e3 * summary.total_time_in_seconds;
   stats_.linear_solver_ms = 1e3 * summary.linear_solver_time_in_seconds;
   stats_.jacobian_ms = 1e3 * summary.jacobian_evaluation_time_in_seconds;

@@ -93,7 +93,8 @@ RunResult runOffline(SensorSource& source, const Config& config, const RunOption
   std::ostringstream frame_stats;
   frame_stats
       << "t,points,lines,points_tracked,lines_tracked,points_used,lines_used,point_residuals,"
-         "line_residuals,w_p,w_l,alpha,iterations,solver_ms,linear_solver_ms,jacobian_ms\n";
+         "line_residuals,w_p,w_l,alpha,iterations,unsuccessful_steps,solver_ms,linear_solver_ms,"
+         "jacobian_ms\n";
   const std::size_t total = options.max_frames > 0
                                 ? std::min<std::size_t>(options.max_frames, source.imageCount())
                                 : source.imageCount();
@@ -154,11 +155,12 @@ RunResult runOffline(SensorSource& source, const Config& config, const RunOption
     if (out.has_pose) {
       const OptimizationStats& o = out.optimization;
       char row[256];
-      std::snprintf(
-          row, sizeof(row), "%.6f,%zu,%zu,%d,%d,%d,%d,%d,%d,%.4f,%.4f,%.2f,%d,%.3f,%.3f,%.3f\n",
-          out.state.t, out.features.points.size(), out.features.lines.size(), o.points_tracked,
-          o.lines_tracked, o.points_used, o.lines_used, o.point_residuals, o.line_residuals, o.w_p,
-          o.w_l, o.alpha, o.iterations, o.solver_ms, o.linear_solver_ms, o.jacobian_ms);
+      std::snprintf(row, sizeof(row),
+                    "%.6f,%zu,%zu,%d,%d,%d,%d,%d,%d,%.4f,%.4f,%.2f,%d,%d,%.3f,%.3f,%.3f\n",
+                    out.state.t, out.features.points.size(), out.features.lines.size(),
+                    o.points_tracked, o.lines_tracked, o.points_used, o.lines_used,
+                    o.point_residuals, o.line_residuals, o.w_p, o.w_l, o.alpha, o.iterations,
+                    o.unsuccessful_steps, o.solver_ms, o.linear_solver_ms, o.jacobian_ms);
       frame_stats << row;
       StampedPose p;
       p.t = out.state.t;
