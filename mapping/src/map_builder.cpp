@@ -51,8 +51,9 @@ MapBuilder::MapBuilder(const MappingOptions& options)
     : options_(options), lines_(options.lines), occupancy_(options.octomap) {}
 
 void MapBuilder::addKeyframe(const KeyframeLandmarks& keyframe) {
-  KeyframeLandmarks kept = keyframe;
-  kept.lines.clear();
+  KeyframeLandmarks kept;  // what passes the filters below
+  kept.t = keyframe.t;
+  kept.T_w_c = keyframe.T_w_c;
   for (const LandmarkSegment& l : keyframe.lines)
     if (l.direction_std_deg >= 0 && l.direction_std_deg <= options_.max_line_direction_std_deg)
       kept.lines.push_back(l);
@@ -61,7 +62,6 @@ void MapBuilder::addKeyframe(const KeyframeLandmarks& keyframe) {
   ++keyframes_;
   lines_.beginKeyframe();
   const Eigen::Vector3d camera = keyframe.T_w_c.translation();
-  kept.points.clear();
   for (const LandmarkPoint& p : keyframe.points) {
     if (!p.p_w.allFinite()) continue;
     if (p.parallax_deg >= 0 && p.parallax_deg < options_.min_point_parallax_deg) continue;
