@@ -50,8 +50,9 @@ RunOutcome runEstimator(const test::SyntheticScenario& s, const Config& c,
     }
     if (std::getenv("ALVIO_LINES"))
       std::cout << "lines: landmarks " << estimator.lines().landmarks().size() << " usable "
-                << estimator.lines().usableCount() << " residuals " << estimator.lastLineResiduals()
-                << " segments " << estimator.lineSegments().size() << "\n";
+                << estimator.lines().usableCount() << " residuals "
+                << estimator.lastOptimizationStats().line_residuals << " segments "
+                << estimator.lineSegments().size() << "\n";
     for (const auto& l : estimator.takeRetiredLines()) out.retired.push_back(l);
     for (const auto& e : estimator.takeEvents())
       if (e.kind == EstimatorEvent::Kind::kInitialized && !out.init) {

@@ -131,10 +131,7 @@ class Estimator {
   std::vector<WindowTrackRecord> takeWindowRecords();
   /// Events since the last call (moved out).
   std::vector<EstimatorEvent> takeEvents();
-  /// Residual blocks and iterations of the last optimisation (diagnostics).
-  int lastIterations() const { return stats_.iterations; }
-  int lastPointResiduals() const { return stats_.point_residuals; }
-  int lastLineResiduals() const { return stats_.line_residuals; }
+  /// Residual blocks, iterations and Ceres times of the last optimisation (diagnostics).
   const OptimizationStats& lastOptimizationStats() const { return stats_; }
   const PointLandmarks& points() const { return points_; }
   const LineLandmarks& lines() const { return lines_; }
