@@ -1,6 +1,11 @@
 // Adaptive point/line weights (ALVIO Sec. 3) and the residual scales the estimator applies.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <string>
+
+#include "alvio/common/error.h"
+#include "alvio/config/yaml_reader.h"
 #include "alvio/estimator/feature_selection.h"
 
 using namespace alvio;
@@ -55,4 +60,30 @@ TEST(ResidualScales, NoResidualsGiveUnitScales) {
   const ResidualScales s = residualScales(w, 0, 0, true);
   EXPECT_DOUBLE_EQ(s.points, 1.0);
   EXPECT_DOUBLE_EQ(s.lines, 1.0);
+}
+
+TEST(ResidualScales, WeightsOnTheCostsScaleResidualsByTheirRoot) {
+  FeatureWeights w;
+  w.w_p = 0.3;
+  w.w_l = 0.7;
+  const ResidualScales raw = residualScales(w, 1300, 280, false, WeightTarget::kCosts);
+  EXPECT_DOUBLE_EQ(raw.points, std::sqrt(0.6));
+  EXPECT_DOUBLE_EQ(raw.lines, std::sqrt(1.4));
+  const ResidualScales s = residualScales(w, 1300, 280, true, WeightTarget::kCosts);
+  // Lines get w_l / w_p times the information of points, not its square.
+  EXPECT_NEAR(s.lines * s.lines / (s.points * s.points), w.w_l / w.w_p, 1e-12);
+  EXPECT_NEAR(s.points * s.points * 1300 + s.lines * s.lines * 280, 1300 + 280, 1e-9);
+}
+
+TEST(FeatureSelectionOptions, WeightsOnNamesTheKeyWhenItIsNeitherResidualsNorCosts) {
+  const FeatureSelectionOptions costs = FeatureSelectionOptions::load(
+      YamlReader::fromString("selection: {weights_on: costs}\n", "test.yaml"), "selection");
+  EXPECT_EQ(costs.weights_on, WeightTarget::kCosts);
+  try {
+    FeatureSelectionOptions::load(
+        YamlReader::fromString("selection: {weights_on: cost}\n", "test.yaml"), "selection");
+    FAIL() << "no error for weights_on: cost";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("selection.weights_on"), std::string::npos) << e.what();
+  }
 }

@@ -85,7 +85,7 @@ void Estimator::updateWeights() {
   stats_.M_l = M_l;
   ResidualScales scales;  // unweighted
   if (o.adaptive_weighting && options_.use_lines)
-    scales = residualScales(w, point_residuals, line_residuals, o.normalize_weights);
+    scales = residualScales(w, point_residuals, line_residuals, o.normalize_weights, o.weights_on);
   point_scale_ = scales.points;
   line_scale_ = scales.lines;
 }

@@ -49,6 +49,12 @@ FeatureSelectionOptions FeatureSelectionOptions::load(const YamlReader& yaml,
   o.alpha_less = yaml.getDouble(p + "alpha_less", o.alpha_less);
   o.similar_band = yaml.getDouble(p + "similar_band", o.similar_band);
   o.normalize_weights = yaml.getBool(p + "normalize_weights", o.normalize_weights);
+  const std::string weights_on = yaml.getString(p + "weights_on", "residuals");
+  if (weights_on == "costs")
+    o.weights_on = WeightTarget::kCosts;
+  else if (weights_on != "residuals")
+    throw Error(yaml.where(p + "weights_on") + " must be residuals or costs, not '" + weights_on +
+                "'");
   for (const char* k : {"alpha_more", "alpha_similar", "alpha_less"})
     if (yaml.getDouble(p + k, 1.0) <= 0) throw Error(yaml.where(p + k) + " must be positive");
   if (o.similar_band < 0) throw Error(yaml.where(p + "similar_band") + " must not be negative");
@@ -82,8 +88,9 @@ FeatureWeights adaptiveWeights(double M_p, double M_l, const FeatureSelectionOpt
 }
 
 ResidualScales residualScales(const FeatureWeights& w, int point_residuals, int line_residuals,
-                              bool normalize) {
+                              bool normalize, WeightTarget target) {
   ResidualScales s{2 * w.w_p, 2 * w.w_l};
+  if (target == WeightTarget::kCosts) s = {std::sqrt(s.points), std::sqrt(s.lines)};
   if (!normalize) return s;
   // Information goes with the square of the scale: keep its sum over all visual residuals.
   const double weighted =

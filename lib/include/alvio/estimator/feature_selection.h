@@ -28,6 +28,10 @@ struct TrackSurface {
   bool keep(double x, double y) const { return !valid() || expected(x, y) >= min_expected_track; }
 };
 
+/// What the adaptive weights multiply: each visual residual (by 2w, so its cost by 4w^2), or
+/// each visual cost term (by 2w, the residual by sqrt(2w)), as in weighted least squares.
+enum class WeightTarget { kResiduals, kCosts };
+
 struct FeatureSelectionOptions {
   bool select_points = false;  ///< leave points in low-value image regions out
   bool select_lines = false;
@@ -42,6 +46,7 @@ struct FeatureSelectionOptions {
   /// information as unweighted: the weights then move trust between points and lines, not
   /// from the camera to the IMU. Off: residuals scaled by 2w (equal weights = unweighted).
   bool normalize_weights = true;
+  WeightTarget weights_on = WeightTarget::kResiduals;
 
   /// Reads `prefix` ("estimator.selection"); a relative surfaces_file is resolved against the
   /// directory of the config file and loaded (errors name that file and key).
@@ -66,6 +71,6 @@ struct ResidualScales {
   double points = 1.0, lines = 1.0;
 };
 ResidualScales residualScales(const FeatureWeights& w, int point_residuals, int line_residuals,
-                              bool normalize);
+                              bool normalize, WeightTarget target = WeightTarget::kResiduals);
 
 }  // namespace alvio
