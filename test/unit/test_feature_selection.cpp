@@ -29,11 +29,12 @@ TEST(AdaptiveWeights, AreThePapersFractionsAndSumToOne) {
 
 TEST(ResidualScales, EqualWeightsLeaveResidualsUnscaled) {
   FeatureWeights equal;  // 0.5 / 0.5
-  for (bool normalize : {false, true}) {
-    const ResidualScales s = residualScales(equal, 1200, 300, normalize);
-    EXPECT_DOUBLE_EQ(s.points, 1.0);
-    EXPECT_DOUBLE_EQ(s.lines, 1.0);
-  }
+  for (bool normalize : {false, true})
+    for (WeightTarget target : {WeightTarget::kResiduals, WeightTarget::kCosts}) {
+      const ResidualScales s = residualScales(equal, 1200, 300, normalize, target);
+      EXPECT_DOUBLE_EQ(s.points, 1.0);
+      EXPECT_DOUBLE_EQ(s.lines, 1.0);
+    }
 }
 
 TEST(ResidualScales, NormalizedKeepTheTotalVisualInformation) {
@@ -41,10 +42,10 @@ TEST(ResidualScales, NormalizedKeepTheTotalVisualInformation) {
   w.w_p = 0.3;
   w.w_l = 0.7;
   const int n_p = 1300, n_l = 280;
-  const ResidualScales raw = residualScales(w, n_p, n_l, false);
+  const ResidualScales raw = residualScales(w, n_p, n_l, false, WeightTarget::kResiduals);
   EXPECT_DOUBLE_EQ(raw.points, 0.6);
   EXPECT_DOUBLE_EQ(raw.lines, 1.4);
-  const ResidualScales s = residualScales(w, n_p, n_l, true);
+  const ResidualScales s = residualScales(w, n_p, n_l, true, WeightTarget::kResiduals);
   // Information is the square of the scale, summed over the residuals.
   EXPECT_NEAR(s.points * s.points * n_p + s.lines * s.lines * n_l, n_p + n_l, 1e-9);
   EXPECT_NEAR(s.lines / s.points, w.w_l / w.w_p, 1e-12);
@@ -57,7 +58,7 @@ TEST(ResidualScales, NoResidualsGiveUnitScales) {
   FeatureWeights w;
   w.w_p = 0.2;
   w.w_l = 0.8;
-  const ResidualScales s = residualScales(w, 0, 0, true);
+  const ResidualScales s = residualScales(w, 0, 0, true, WeightTarget::kCosts);
   EXPECT_DOUBLE_EQ(s.points, 1.0);
   EXPECT_DOUBLE_EQ(s.lines, 1.0);
 }

@@ -49,7 +49,7 @@ FeatureSelectionOptions FeatureSelectionOptions::load(const YamlReader& yaml,
   o.alpha_less = yaml.getDouble(p + "alpha_less", o.alpha_less);
   o.similar_band = yaml.getDouble(p + "similar_band", o.similar_band);
   o.normalize_weights = yaml.getBool(p + "normalize_weights", o.normalize_weights);
-  const std::string weights_on = yaml.getString(p + "weights_on", "residuals");
+  const std::string weights_on = yaml.getString(p + "weights_on", "costs");
   if (weights_on == "costs")
     o.weights_on = WeightTarget::kCosts;
   else if (weights_on != "residuals")

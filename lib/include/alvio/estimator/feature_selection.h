@@ -37,16 +37,17 @@ struct FeatureSelectionOptions {
   bool select_lines = false;
   std::string surfaces_file;  ///< selection_surfaces.yaml (alvio analyze); relative to the config
   TrackSurface point_surface, line_surface;  ///< loaded from surfaces_file
-  bool adaptive_weighting = false;
+  bool adaptive_weighting = true;
   double alpha_more = 5.0;     ///< lines track longer than points
   double alpha_similar = 2.2;  ///< about as long
   double alpha_less = 1.0;     ///< shorter
   double similar_band = 0.2;   ///< |M_l - M_p| <= band * max(M_l, M_p) counts as "about as long"
   /// Scale the weighted residuals so that points and lines together carry as much
   /// information as unweighted: the weights then move trust between points and lines, not
-  /// from the camera to the IMU. Off: residuals scaled by 2w (equal weights = unweighted).
+  /// from the camera to the IMU. Off: the 2w of `weights_on` as it is (equal weights =
+  /// unweighted).
   bool normalize_weights = true;
-  WeightTarget weights_on = WeightTarget::kResiduals;
+  WeightTarget weights_on = WeightTarget::kCosts;
 
   /// Reads `prefix` ("estimator.selection"); a relative surfaces_file is resolved against the
   /// directory of the config file and loaded (errors name that file and key).
@@ -71,6 +72,6 @@ struct ResidualScales {
   double points = 1.0, lines = 1.0;
 };
 ResidualScales residualScales(const FeatureWeights& w, int point_residuals, int line_residuals,
-                              bool normalize, WeightTarget target = WeightTarget::kResiduals);
+                              bool normalize, WeightTarget target);
 
 }  // namespace alvio
