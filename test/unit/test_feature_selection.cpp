@@ -80,6 +80,12 @@ TEST(FeatureSelectionOptions, WeightsOnNamesTheKeyWhenItIsNeitherResidualsNorCos
   const FeatureSelectionOptions costs = FeatureSelectionOptions::load(
       YamlReader::fromString("selection: {weights_on: costs}\n", "test.yaml"), "selection");
   EXPECT_EQ(costs.weights_on, WeightTarget::kCosts);
+  const FeatureSelectionOptions residuals = FeatureSelectionOptions::load(
+      YamlReader::fromString("selection: {weights_on: residuals}\n", "test.yaml"), "selection");
+  EXPECT_EQ(residuals.weights_on, WeightTarget::kResiduals);
+  const FeatureSelectionOptions unset = FeatureSelectionOptions::load(
+      YamlReader::fromString("selection: {adaptive_weighting: true}\n", "test.yaml"), "selection");
+  EXPECT_EQ(unset.weights_on, FeatureSelectionOptions().weights_on);
   try {
     FeatureSelectionOptions::load(
         YamlReader::fromString("selection: {weights_on: cost}\n", "test.yaml"), "selection");

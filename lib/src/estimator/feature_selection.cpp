@@ -49,12 +49,12 @@ FeatureSelectionOptions FeatureSelectionOptions::load(const YamlReader& yaml,
   o.alpha_less = yaml.getDouble(p + "alpha_less", o.alpha_less);
   o.similar_band = yaml.getDouble(p + "similar_band", o.similar_band);
   o.normalize_weights = yaml.getBool(p + "normalize_weights", o.normalize_weights);
-  const std::string weights_on = yaml.getString(p + "weights_on", "costs");
-  if (weights_on == "costs")
-    o.weights_on = WeightTarget::kCosts;
-  else if (weights_on != "residuals")
+  const bool costs = o.weights_on == WeightTarget::kCosts;
+  const std::string weights_on = yaml.getString(p + "weights_on", costs ? "costs" : "residuals");
+  if (weights_on != "costs" && weights_on != "residuals")
     throw Error(yaml.where(p + "weights_on") + " must be residuals or costs, not '" + weights_on +
                 "'");
+  o.weights_on = weights_on == "costs" ? WeightTarget::kCosts : WeightTarget::kResiduals;
   for (const char* k : {"alpha_more", "alpha_similar", "alpha_less"})
     if (yaml.getDouble(p + k, 1.0) <= 0) throw Error(yaml.where(p + k) + " must be positive");
   if (o.similar_band < 0) throw Error(yaml.where(p + "similar_band") + " must not be negative");
