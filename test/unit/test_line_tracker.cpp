@@ -218,6 +218,40 @@ TEST(OpticalFlowLineTracker, Type1KeptLinesKeepTheirIds) {
   }
 }
 
+TEST(OpticalFlowLineTracker, DetectEveryOtherFrameCarriesLinesOnTheirFlow) {
+  const test::SyntheticLineScene scene(kSize);
+  LineTrackerOptions options = defaultOptions();
+  options.flow.detect_every = 2;
+  OpticalFlowLineTracker tracker(test::undistortedCamera(), options);
+  const LineFrame f1 = tracker.track(scene.render(kBars, {0, 0}), 0.0);
+  ASSERT_GE(f1.lines.size(), 10u);
+  // A bar appears in frame 2, which is not detected: no new line before frame 3.
+  std::vector<Bar> more = kBars;
+  const Bar added{{680, 200}, {200, 40}, 90};
+  more.push_back(added);
+  const cv::Point2d o2(6.4, -3.9), o3(12.1, -7.5);
+  const LineFrame f2 = tracker.track(scene.render(more, o2), 0.05);
+  EXPECT_EQ(f2.stats.detected, 0);
+  EXPECT_EQ(f2.stats.new_lines, 0);
+  EXPECT_EQ(f2.stats.tracked, static_cast<int>(f1.lines.size()));
+  const auto before = byId(f1);
+  const Eigen::Vector2d d2(o2.x, o2.y);
+  for (const auto& [id, obs] : byId(f2)) {
+    ASSERT_TRUE(before.count(id)) << "unknown id " << id;
+    EXPECT_EQ(obs.track_count, 2);
+    // On the moved edge: the flow prediction alone is this frame's line.
+    const LineSegment moved(before.at(id).start_px + d2, before.at(id).end_px + d2);
+    EXPECT_LT(moved.distanceToLine(obs.start_px), 1.0) << "id " << id;
+    EXPECT_LT(moved.distanceToLine(obs.end_px), 1.0) << "id " << id;
+  }
+  const LineFrame f3 = tracker.track(scene.render(more, o3), 0.10);
+  EXPECT_GT(f3.stats.detected, 0);
+  EXPECT_EQ(f3.stats.tracked, static_cast<int>(f1.lines.size()));
+  EXPECT_EQ(f3.stats.new_lines, 2);
+  for (const auto& obs : f3.lines)
+    if (before.count(obs.id)) EXPECT_EQ(obs.track_count, 3);
+}
+
 TEST(OpticalFlowLineTracker, Type2NewLinesGetNewIds) {
   const test::SyntheticLineScene scene(kSize);
   OpticalFlowLineTracker tracker(test::undistortedCamera(), defaultOptions());
@@ -414,7 +448,7 @@ TEST(LineTracker, DistortedStraightEdgeComesOutStraightInNormalisedCoordinates) 
 TEST(LineTrackerOptions, LoadFromYamlAndNameBadKeys) {
   const auto yaml = YamlReader::fromString(
       "lines:\n  tracker: descriptor\n  detector: {max_lines: 25, lsd_scale: 0.8, lsd_quant: 4}\n"
-      "  flow: {samples_per_line: 7}\n",
+      "  flow: {samples_per_line: 7, detect_every: 3}\n",
       "test.yaml");
   const LineTrackerOptions o = LineTrackerOptions::load(yaml, "lines");
   EXPECT_EQ(o.tracker, "descriptor");
@@ -423,6 +457,7 @@ TEST(LineTrackerOptions, LoadFromYamlAndNameBadKeys) {
   EXPECT_DOUBLE_EQ(o.detector.lsd_quant, 4.0);
   EXPECT_DOUBLE_EQ(o.detector.min_length_ratio, 0.06);
   EXPECT_EQ(o.flow.samples_per_line, 7);
+  EXPECT_EQ(o.flow.detect_every, 3);
   EXPECT_TRUE(yaml.unknownKeys().empty());
   EXPECT_EQ(createLineTracker(test::undistortedCamera(), o)->name(), std::string("descriptor"));
 
@@ -434,6 +469,13 @@ TEST(LineTrackerOptions, LoadFromYamlAndNameBadKeys) {
     EXPECT_NE(std::string(e.what()).find("bad.yaml"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("lines.flow.klt_window_px"), std::string::npos)
         << e.what();
+  }
+  const auto bad_every = YamlReader::fromString("lines:\n  flow: {detect_every: 0}\n", "e.yaml");
+  try {
+    LineTrackerOptions::load(bad_every, "lines");
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("lines.flow.detect_every"), std::string::npos) << e.what();
   }
   const auto bad_quant = YamlReader::fromString("lines:\n  detector: {lsd_quant: 0}\n", "q.yaml");
   EXPECT_THROW(LineTrackerOptions::load(bad_quant, "lines"), Error);

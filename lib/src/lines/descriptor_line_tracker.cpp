@@ -13,7 +13,7 @@ DescriptorLineTracker::DescriptorLineTracker(const CameraOptions& camera,
     : LineTracker(camera, options) {}
 
 void DescriptorLineTracker::associate(const cv::Mat& undistorted,
-                                      const std::vector<LineSegment>& detections,
+                                      const std::vector<LineSegment>& detections, bool /*detected*/,
                                       LineFrame* frame) {
   const auto& o = options_.descriptor;
   const cv::Mat descriptors = lbd_.compute(undistorted, detections);

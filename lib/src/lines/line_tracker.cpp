@@ -36,14 +36,15 @@ LineFrame LineTracker::trackUndistorted(const cv::Mat& undistorted, double t) {
   LineFrame frame;
   frame.t = t;
   auto start = std::chrono::steady_clock::now();
+  const bool detect = detectsThisFrame();
   const std::vector<LineSegment> detections =
-      detector_.detect(undistorted, undistorter_.validMask());
+      detect ? detector_.detect(undistorted, undistorter_.validMask()) : std::vector<LineSegment>();
   frame.stats.detect_ms = msSince(start);
   for (const LineSegment& s : detections)
     frame.stats.detected += s.length() >= detector_.minLength();
 
   start = std::chrono::steady_clock::now();
-  associate(undistorted, detections, &frame);
+  associate(undistorted, detections, detect, &frame);
   for (LineObservation& obs : frame.lines) {
     obs.start_norm = undistorter_.pixelToNormalised(obs.start_px);
     obs.end_norm = undistorter_.pixelToNormalised(obs.end_px);

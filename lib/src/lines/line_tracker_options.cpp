@@ -75,6 +75,7 @@ FlowLineTrackerOptions FlowLineTrackerOptions::load(const YamlReader& yaml,
   o.min_overlap_ratio = yaml.getDouble(p + "min_overlap_ratio", o.min_overlap_ratio);
   o.min_length_ratio = yaml.getDouble(p + "min_length_ratio", o.min_length_ratio);
   o.max_center_distance_px = yaml.getDouble(p + "max_center_distance_px", o.max_center_distance_px);
+  o.detect_every = yaml.getInt(p + "detect_every", o.detect_every);
   o.validate(whereOf(yaml, prefix));
   return o;
 }
@@ -97,6 +98,7 @@ void FlowLineTrackerOptions::validate(const std::string& where) const {
           min_length_ratio);
   require(max_center_distance_px > 0, where, "max_center_distance_px", "positive",
           max_center_distance_px);
+  require(detect_every >= 1, where, "detect_every", ">= 1", detect_every);
 }
 
 DescriptorLineTrackerOptions DescriptorLineTrackerOptions::load(const YamlReader& yaml,

@@ -154,8 +154,18 @@ void OpticalFlowLineTracker::predict(const std::vector<cv::Mat>& pyramid, cv::Si
         predictOne(tracks_[i], moved, status, i * n, image_size, &predictions_[i]);
 }
 
+bool OpticalFlowLineTracker::detectsThisFrame() {
+  // Without lines to carry forward only the detector can start some.
+  if (tracks_.empty() || frames_since_detection_ + 1 >= options_.flow.detect_every) {
+    frames_since_detection_ = 0;
+    return true;
+  }
+  ++frames_since_detection_;
+  return false;
+}
+
 void OpticalFlowLineTracker::associate(const cv::Mat& undistorted,
-                                       const std::vector<LineSegment>& detections,
+                                       const std::vector<LineSegment>& detections, bool detected,
                                        LineFrame* frame) {
   const auto& f = options_.flow;
   std::vector<cv::Mat> pyramid;
@@ -165,7 +175,38 @@ void OpticalFlowLineTracker::associate(const cv::Mat& undistorted,
                               f.klt_pyramid_levels, true, cv::BORDER_REFLECT_101,
                               cv::BORDER_CONSTANT, false);
   predict(pyramid, undistorted.size());
+  std::vector<Track> next = detected ? match(detections, frame) : carryPredictions(frame);
 
+  frame->lines.clear();
+  for (const Track& t : next) {
+    LineObservation obs;
+    obs.id = t.id;
+    obs.start_px = t.segment.start;
+    obs.end_px = t.segment.end;
+    obs.track_count = t.count;
+    frame->lines.push_back(obs);
+  }
+  tracks_ = std::move(next);
+  prev_pyramid_ = std::move(pyramid);
+}
+
+std::vector<OpticalFlowLineTracker::Track> OpticalFlowLineTracker::carryPredictions(
+    LineFrame* frame) const {
+  std::vector<Track> next;
+  for (std::size_t i = 0; i < predictions_.size(); ++i) {
+    const Prediction& p = predictions_[i];
+    // As short as a detection may be and still continue a track, at the least.
+    if (!p.valid || p.segment.length() < detector().shortestLength()) continue;
+    next.push_back({tracks_[i].id, p.segment, tracks_[i].count + 1});
+    ++frame->stats.tracked;
+    frame->stats.clipped += p.clipped;
+  }
+  return next;
+}
+
+std::vector<OpticalFlowLineTracker::Track> OpticalFlowLineTracker::match(
+    const std::vector<LineSegment>& detections, LineFrame* frame) {
+  const auto& f = options_.flow;
   // Candidates: the K best detections per prediction that pass angle, distance and overlap.
   const double max_angle = f.max_angle_deg * kDegToRad;
   std::vector<Candidate> candidates;
@@ -237,18 +278,7 @@ void OpticalFlowLineTracker::associate(const cv::Mat& undistorted,
     next.push_back({newId(), detections[j], 1});
     ++frame->stats.new_lines;
   }
-
-  frame->lines.clear();
-  for (const Track& t : next) {
-    LineObservation obs;
-    obs.id = t.id;
-    obs.start_px = t.segment.start;
-    obs.end_px = t.segment.end;
-    obs.track_count = t.count;
-    frame->lines.push_back(obs);
-  }
-  tracks_ = std::move(next);
-  prev_pyramid_ = std::move(pyramid);
+  return next;
 }
 
 }  // namespace alvio

@@ -19,8 +19,9 @@ class DescriptorLineTracker final : public LineTracker {
   const char* name() const override { return "descriptor"; }
 
  protected:
+  /// Detects on every frame (descriptors need detections), so `detected` is always true.
   void associate(const cv::Mat& undistorted, const std::vector<LineSegment>& detections,
-                 LineFrame* frame) override;
+                 bool detected, LineFrame* frame) override;
 
  private:
   LbdExtractor lbd_;

@@ -47,10 +47,14 @@ class LineTracker {
   virtual const char* name() const = 0;
 
  protected:
+  /// Whether the detector runs on this frame (called once per frame, before associate()).
+  virtual bool detectsThisFrame() { return true; }
   /// Associate this frame's detections with the previous frame's lines: fill `frame.lines`
   /// (pixel coordinates, id, track_count) and the association counters of `frame.stats`.
+  /// `detected` is false when detectsThisFrame() skipped the detector (`detections` is empty).
   virtual void associate(const cv::Mat& undistorted, const std::vector<LineSegment>& detections,
-                         LineFrame* frame) = 0;
+                         bool detected, LineFrame* frame) = 0;
+  const LineDetector& detector() const { return detector_; }
   int newId() { return next_id_++; }
   /// The unused detections that start new lines this frame: long enough for a new line,
   /// longest first, no more than leave room under max_lines after `tracked` lines.

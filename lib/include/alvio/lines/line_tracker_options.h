@@ -69,6 +69,10 @@ struct FlowLineTrackerOptions {
   /// predicted one and a centre within max_center_distance_px of it.
   double min_length_ratio = 0.5;
   double max_center_distance_px = 50.0;
+  /// The detector runs on every N-th frame only; in between, tracked lines continue on their
+  /// optical-flow predictions (which already fit a line to KLT samples) and no line starts.
+  /// 1: every frame, as in the paper.
+  int detect_every = 1;
 
   static FlowLineTrackerOptions load(const YamlReader& yaml, const std::string& prefix);
   void validate(const std::string& where) const;

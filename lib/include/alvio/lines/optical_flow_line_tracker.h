@@ -16,6 +16,8 @@
 //     (type 3). The result must pass the length-ratio and centre-distance filters, else the best
 //     single detection is tried. Matched lines keep their ID (types 1, 3, 4); the remaining
 //     detections get new IDs (type 2).
+// With flow.detect_every = N > 1 the detector runs on every N-th frame only; on the frames in
+// between, step 1's predictions are the lines (no matching, no new lines).
 
 #include <opencv2/core.hpp>
 #include <vector>
@@ -39,8 +41,9 @@ class OpticalFlowLineTracker final : public LineTracker {
   const std::vector<Prediction>& lastPredictions() const { return predictions_; }
 
  protected:
+  bool detectsThisFrame() override;
   void associate(const cv::Mat& undistorted, const std::vector<LineSegment>& detections,
-                 LineFrame* frame) override;
+                 bool detected, LineFrame* frame) override;
 
  private:
   struct Track {
@@ -49,6 +52,10 @@ class OpticalFlowLineTracker final : public LineTracker {
     int count;
   };
   void predict(const std::vector<cv::Mat>& pyramid, cv::Size image_size);
+  /// Steps 2 and 3: this frame's lines from the predictions and the detections.
+  std::vector<Track> match(const std::vector<LineSegment>& detections, LineFrame* frame);
+  /// A frame without detections: the valid predictions are this frame's lines.
+  std::vector<Track> carryPredictions(LineFrame* frame) const;
   bool predictOne(const Track& track, const std::vector<cv::Point2f>& moved,
                   const std::vector<uchar>& status, std::size_t first, cv::Size image_size,
                   Prediction* prediction) const;
@@ -56,6 +63,7 @@ class OpticalFlowLineTracker final : public LineTracker {
   std::vector<Track> tracks_;
   std::vector<cv::Mat> prev_pyramid_;
   std::vector<Prediction> predictions_;
+  int frames_since_detection_ = 0;
 };
 
 }  // namespace alvio
