@@ -25,8 +25,6 @@ PointTrackerOptions PointTrackerOptions::load(const YamlReader& yaml, const std:
   o.forward_backward_check = yaml.getBool(p + "forward_backward_check", o.forward_backward_check);
   o.forward_backward_max_px =
       yaml.getDouble(p + "forward_backward_max_px", o.forward_backward_max_px);
-  o.detect_every = yaml.getInt(p + "detect_every", o.detect_every);
-  if (o.detect_every < 1) throw Error(yaml.where(p + "detect_every") + " must be at least 1");
   if (o.exposure_jump < 0) throw Error(yaml.where(p + "exposure_jump") + " must not be negative");
   if (o.max_features < 8) throw Error(yaml.where(p + "max_features") + " must be at least 8");
   if (o.min_distance_px < 1) throw Error(yaml.where(p + "min_distance_px") + " must be at least 1");
@@ -41,7 +39,6 @@ PointTracker::PointTracker(const PointTrackerOptions& options,
 
 void PointTracker::reset() {
   prev_img_.release();
-  frames_since_detection_ = 0;
   pts_.clear();
   ids_.clear();
   track_counts_.clear();
@@ -142,13 +139,7 @@ FeatureFrame PointTracker::track(const cv::Mat& gray, int64_t t_ns, FrameTiming*
 
   {
     ScopedStage stage(timing, "point_detection");
-    // Without tracked points only detection can start some.
-    if (pts_.empty() || frames_since_detection_ + 1 >= options_.detect_every) {
-      detectNew(img);
-      frames_since_detection_ = 0;
-    } else {
-      ++frames_since_detection_;
-    }
+    detectNew(img);
   }
 
   // Normalised coordinates and their velocities against the previous frame.

@@ -30,8 +30,6 @@ struct PointTrackerOptions {
   int klt_levels = 3;
   bool forward_backward_check = true;  ///< track back and reject points that do not return
   double forward_backward_max_px = 0.5;
-  /// New corners are detected on every N-th frame only (1: every frame, as VINS-Mono does).
-  int detect_every = 1;
 
   static PointTrackerOptions load(const YamlReader& yaml, const std::string& prefix);
 };
@@ -65,7 +63,6 @@ class PointTracker {
   std::vector<Eigen::Vector2d> prev_xy_;  // by index into pts_ of the previous frame
   std::vector<int> prev_ids_;
   int next_id_ = 0;
-  int frames_since_detection_ = 0;
 };
 
 }  // namespace alvio
