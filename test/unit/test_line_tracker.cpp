@@ -51,8 +51,11 @@ std::map<int, LineObservation> byId(const LineFrame& f) {
   return m;
 }
 
+// The type tests match detections on every frame, as the paper's tracker does.
 LineTrackerOptions defaultOptions() {
-  return LineTrackerOptions();
+  LineTrackerOptions o;
+  o.flow.detect_every = 1;
+  return o;
 }
 
 // A scene with bars of several orientations, all edges >= the minimum length (54 px).
