@@ -255,6 +255,22 @@ TEST(OpticalFlowLineTracker, DetectEveryOtherFrameCarriesLinesOnTheirFlow) {
     if (before.count(obs.id)) EXPECT_EQ(obs.track_count, 3);
 }
 
+TEST(OpticalFlowLineTracker, FlowThatLosesMostLinesMakesTheNextFrameDetect) {
+  const test::SyntheticLineScene scene(kSize);
+  LineTrackerOptions options = defaultOptions();
+  options.flow.detect_every = 2;
+  OpticalFlowLineTracker tracker(test::undistortedCamera(), options);
+  ASSERT_GT(tracker.track(scene.render(kBars, {0, 0}), 0.0).stats.detected, 0);
+  EXPECT_EQ(tracker.track(scene.render(kBars, {4, -2}), 0.05).stats.detected, 0);
+  // The view changes completely: frame 3 detects on schedule, but its flow lost every line.
+  const std::vector<Bar> elsewhere = {{{380, 240}, {300, 50}, 45}};
+  ASSERT_GT(tracker.track(scene.render(elsewhere, {0, 0}), 0.10).stats.detected, 0);
+  // So frame 4, which the schedule would skip, detects as well.
+  EXPECT_GT(tracker.track(scene.render(elsewhere, {3, 2}), 0.15).stats.detected, 0);
+  // Its flow kept the lines: frame 5 is skipped again.
+  EXPECT_EQ(tracker.track(scene.render(elsewhere, {6, 4}), 0.20).stats.detected, 0);
+}
+
 TEST(OpticalFlowLineTracker, Type2NewLinesGetNewIds) {
   const test::SyntheticLineScene scene(kSize);
   OpticalFlowLineTracker tracker(test::undistortedCamera(), defaultOptions());

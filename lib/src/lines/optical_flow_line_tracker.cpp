@@ -11,6 +11,9 @@ constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
 constexpr double kFlowOutlierPx = 2.0;
 // The along-line scale between frames is trusted only within this range (else a shift).
 constexpr double kMinAlongScale = 0.67, kMaxAlongScale = 1.5;
+// The flow of a frame that predicted fewer of its lines than this is not trusted to carry
+// lines without detection on the next frame.
+constexpr double kMinReliableFlowFraction = 0.8;
 
 // The line through the largest set of points within kFlowOutlierPx of the line through some
 // pair of them (all pairs are tried: a handful of samples per line), refitted to that set. A
@@ -149,14 +152,19 @@ void OpticalFlowLineTracker::predict(const std::vector<cv::Mat>& pyramid, cv::Si
                            cv::Size(f.klt_window_px, f.klt_window_px), f.klt_pyramid_levels,
                            cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS,
                                             f.klt_max_iterations, f.klt_epsilon));
+  std::size_t valid = 0;
   for (std::size_t i = 0; i < tracks_.size(); ++i)
-    predictions_[i].valid =
+    valid += predictions_[i].valid =
         predictOne(tracks_[i], moved, status, i * n, image_size, &predictions_[i]);
+  flow_reliable_ = valid >= kMinReliableFlowFraction * tracks_.size();
 }
 
 bool OpticalFlowLineTracker::detectsThisFrame() {
-  // Without lines to carry forward only the detector can start some.
-  if (tracks_.empty() || frames_since_detection_ + 1 >= options_.flow.detect_every) {
+  // Without lines to carry forward only the detector can start some. When the last frame's
+  // flow lost many lines (fast motion, a light change), the survivors are checked against
+  // detections too: a carried line is only as good as its flow.
+  if (tracks_.empty() || !flow_reliable_ ||
+      frames_since_detection_ + 1 >= options_.flow.detect_every) {
     frames_since_detection_ = 0;
     return true;
   }

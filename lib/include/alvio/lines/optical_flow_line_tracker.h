@@ -17,7 +17,8 @@
 //     single detection is tried. Matched lines keep their ID (types 1, 3, 4); the remaining
 //     detections get new IDs (type 2).
 // With flow.detect_every = N > 1 the detector runs on every N-th frame only; on the frames in
-// between, step 1's predictions are the lines (no matching, no new lines).
+// between, step 1's predictions are the lines (no matching, no new lines). A frame whose
+// predictions lost over a fifth of the lines makes the next one detect.
 
 #include <opencv2/core.hpp>
 #include <vector>
@@ -64,6 +65,7 @@ class OpticalFlowLineTracker final : public LineTracker {
   std::vector<cv::Mat> prev_pyramid_;
   std::vector<Prediction> predictions_;
   int frames_since_detection_ = 0;
+  bool flow_reliable_ = true;  ///< the last prediction kept most lines
 };
 
 }  // namespace alvio
