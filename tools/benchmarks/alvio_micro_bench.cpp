@@ -90,10 +90,13 @@ BENCHMARK(BM_LineDetectionFldHalfScale)->Unit(benchmark::kMillisecond);
 
 // Detection + undistortion + tracking, alternating between the two frames so that tracks
 // live on (the steady state of the flow tracker: mostly Type 1 lines).
-void trackLines(benchmark::State& state, const std::string& kind) {
+// detect_every as configured (the flow tracker's default detects on every other frame, so the
+// time is the mean over both kinds of frame), or 1 for the paper's tracker.
+void trackLines(benchmark::State& state, const std::string& kind, int detect_every = 0) {
   const FramePair& f = framePair();
   LineTrackerOptions options = config().lines;
   options.tracker = kind;
+  if (detect_every > 0) options.flow.detect_every = detect_every;
   auto tracker = createLineTracker(config().camera, options);
   double t = 0;
   tracker->track(f.a, t);
@@ -110,10 +113,14 @@ void trackLines(benchmark::State& state, const std::string& kind) {
 void BM_LineTrackingFlow(benchmark::State& state) {
   trackLines(state, "flow");
 }
+void BM_LineTrackingFlowDetectEveryFrame(benchmark::State& state) {
+  trackLines(state, "flow", 1);
+}
 void BM_LineTrackingDescriptor(benchmark::State& state) {
   trackLines(state, "descriptor");
 }
 BENCHMARK(BM_LineTrackingFlow)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_LineTrackingFlowDetectEveryFrame)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_LineTrackingDescriptor)->Unit(benchmark::kMillisecond);
 
 void BM_PointTracking(benchmark::State& state) {
