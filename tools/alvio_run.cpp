@@ -10,6 +10,7 @@
 
 #include "alvio/common/arg_parser.h"
 #include "alvio/common/error.h"
+#include "alvio/common/heap_retention.h"
 #include "alvio/common/logging.h"
 #include "alvio/common/stop_signal.h"
 #include "alvio/config/config.h"
@@ -81,6 +82,7 @@ int main(int argc, char** argv) {
     options.max_frames = args.getInt("max-frames");
     options.progress = !args.isSet("quiet");
     options.stop = &installStopSignalHandlers();
+    retainFreedHeapMemory();  // per-frame image temporaries stay mapped
     std::unique_ptr<RunLogger> logger;
     if (config.logger.enabled && !args.isSet("no-log")) {
       logger = std::make_unique<RunLogger>(config.logger);
