@@ -5,12 +5,13 @@
 # wrote, and where every output file is.
 #
 #   scripts/ros_demo.sh [--rate R] [--out DIR]      (./alvio demo builds first)
-#   scripts/ros_demo.sh --bag FILE [--groundtruth TUM] [--record-status] ...
+#   scripts/ros_demo.sh --bag FILE [--groundtruth TUM] [--record-status] [--no-logging] ...
 #
 # The demo sequence comes from $ALVIO_DEMO_DATA, out/demo/sim, ../data/demo, or is
 # rendered with alvio_sim --demo when that tool is built. --bag plays another bag instead
 # (the ATE needs --groundtruth); --record-status keeps the estimator's status messages in
-# <out>/run/status.bag (the fault-injection suite reads them).
+# <out>/run/status.bag (the fault-injection suite reads them); --no-logging leaves the MRPT
+# logger out, as the launch file's default does (latency measurements).
 set -euo pipefail
 
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -21,6 +22,7 @@ out="$ROOT/out/demo"
 bag=""
 gt=""
 record_status=false
+logging=true
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --rate) rate="$2"; shift 2 ;;
@@ -28,7 +30,8 @@ while [[ $# -gt 0 ]]; do
     --bag) bag="$2"; shift 2 ;;
     --groundtruth) gt="$2"; shift 2 ;;
     --record-status) record_status=true; shift ;;
-    -h|--help) sed -n '2,16p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --no-logging) logging=false; shift ;;
+    -h|--help) sed -n '2,14p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "demo: unknown option $1" >&2; exit 2 ;;
   esac
 done
@@ -77,7 +80,7 @@ if $record_status; then
 fi
 log "playing $(basename "$bag") at rate $rate through the nodelet pipeline (master $ROS_MASTER_URI)"
 start=$(date +%s)
-roslaunch alvio sim.launch bag:="$bag" rate:="$rate" output_dir:="$run" logging:=true \
+roslaunch alvio sim.launch bag:="$bag" rate:="$rate" output_dir:="$run" logging:="$logging" \
   exit_at_end:=false >"$out/roslaunch.log" 2>&1 &
 launch_pid=$!
 trap 'kill -INT "$launch_pid" ${record_pid:-} 2>/dev/null || true; kill "$core_pid" 2>/dev/null || true; wait 2>/dev/null || true' EXIT
