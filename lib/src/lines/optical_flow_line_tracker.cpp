@@ -152,18 +152,21 @@ void OpticalFlowLineTracker::predict(const std::vector<cv::Mat>& pyramid, cv::Si
                            cv::Size(f.klt_window_px, f.klt_window_px), f.klt_pyramid_levels,
                            cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS,
                                             f.klt_max_iterations, f.klt_epsilon));
-  std::size_t valid = 0;
   for (std::size_t i = 0; i < tracks_.size(); ++i)
-    valid += predictions_[i].valid =
+    predictions_[i].valid =
         predictOne(tracks_[i], moved, status, i * n, image_size, &predictions_[i]);
-  flow_reliable_ = valid >= kMinReliableFlowFraction * tracks_.size();
 }
 
 bool OpticalFlowLineTracker::detectsThisFrame() {
   // Without lines to carry forward only the detector can start some. When the last frame's
   // flow lost many lines (fast motion, a light change), the survivors are checked against
   // detections too: a carried line is only as good as its flow.
-  if (tracks_.empty() || !flow_reliable_ ||
+  // predictions_ still holds the last frame's flow.
+  const auto kept = std::count_if(predictions_.begin(), predictions_.end(),
+                                  [](const Prediction& p) { return p.valid; });
+  const bool flow_reliable =
+      static_cast<double>(kept) >= kMinReliableFlowFraction * predictions_.size();
+  if (tracks_.empty() || !flow_reliable ||
       frames_since_detection_ + 1 >= options_.flow.detect_every) {
     frames_since_detection_ = 0;
     return true;

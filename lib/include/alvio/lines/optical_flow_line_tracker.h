@@ -65,7 +65,6 @@ class OpticalFlowLineTracker final : public LineTracker {
   std::vector<cv::Mat> prev_pyramid_;
   std::vector<Prediction> predictions_;
   int frames_since_detection_ = 0;
-  bool flow_reliable_ = true;  ///< the last prediction kept most lines
 };
 
 }  // namespace alvio
