@@ -12,7 +12,7 @@ namespace alvio {
 /// Keep up to `trim_bytes` of freed memory in the process, and serve allocations up to
 /// glibc's largest mmap threshold (32 MB) from the heap. Process-wide: call it from a
 /// program's main(), not from library code. Returns false where the allocator refuses
-/// (not glibc).
+/// (not glibc). launch/alvio.launch sets the same thresholds through GLIBC_TUNABLES.
 bool retainFreedHeapMemory(std::size_t trim_bytes = std::size_t{64} << 20);
 
 }  // namespace alvio
