@@ -3,7 +3,9 @@
 // alignment brings the map lines (lines.csv) and the occupied OctoMap voxels (octomap.bt) into
 // the true world, where they are compared with the scene's edges and surfaces: line angle and
 // midpoint distance to the nearest true edge, line map precision / recall, fraction of voxels
-// near a surface, and the map's size.
+// near a surface, and the map's size. The line figures are given twice: against the geometry's
+// edges alone, and against those plus the straight albedo edges of the surfaces' textures
+// (brick joints, seams, stripes: sim/texture_edges.h), which a line map rightly holds too.
 #include <octomap/OcTree.h>
 #include <filesystem>
 #include <iomanip>
@@ -21,6 +23,7 @@
 #include "alvio/sim/edge_projection.h"
 #include "alvio/sim/sequence_scene.h"
 #include "alvio/sim/surface_distance.h"
+#include "alvio/sim/texture_edges.h"
 
 using namespace alvio;
 namespace fs = std::filesystem;
@@ -39,6 +42,7 @@ int main(int argc, char** argv) {
   args.option("line-distance", "line map tolerance: distance to a true edge (m)", "0.10");
   args.option("line-angle", "line map tolerance: angle to a true edge (deg)", "3");
   args.option("voxel-tolerance", "voxel centre to a true surface (m); default 2 voxels", "");
+  args.flag("no-texture-edges", "judge lines against the geometry's edges only (faster)");
   args.option("json", "write every figure to this JSON file");
   args.option("per-line", "write each map line's error (true world) to this CSV file");
   try {
@@ -74,6 +78,24 @@ int main(int argc, char** argv) {
                                                               : 2 * tree->getResolution();
     const MapTruthEvaluation m = evaluateMapAgainstTruth(lines, tree.get(), traj.alignment, edges,
                                                          surface_distance, options);
+    // The same lines against the geometry's and the textures' edges together.
+    std::vector<Segment3> all_edges = edges;
+    std::size_t texture_edges = 0;
+    if (!args.isSet("no-texture-edges")) {
+      sim::AppearanceOptions ao;
+      ao.texture_density = sim::textureDensityFromSimInfo((seq / "sim_info.yaml").string());
+      ao.occlusion_rays = 0;  // light maps are not needed: no shadow or occlusion rays
+      ao.shadows = false;
+      for (const sim::SceneEdge& e :
+           sim::sceneTextureEdges(scene.scene, sim::SceneAppearance(scene.scene, ao))) {
+        all_edges.push_back({e.a, e.b});
+        ++texture_edges;
+      }
+    }
+    const MapTruthEvaluation mt =
+        texture_edges > 0 ? evaluateMapAgainstTruth(lines, nullptr, traj.alignment, all_edges,
+                                                    surface_distance, options)
+                          : MapTruthEvaluation{};
     const VoxelCounts voxels = countVoxels(*tree);
 
     const nlohmann::json report = {
@@ -98,7 +120,13 @@ int main(int argc, char** argv) {
           {"recall", m.line_map.recall},
           {"map_length_m", m.line_map.map_length_m},
           {"true_edges", m.line_map.true_edges},
-          {"true_length_m", m.line_map.true_length_m}}},
+          {"true_length_m", m.line_map.true_length_m},
+          {"with_texture_edges",
+           {{"texture_edges", texture_edges},
+            {"precision", mt.line_map.precision},
+            {"median_angle_deg", mt.line_errors.median_angle_deg},
+            {"median_midpoint_distance_m", mt.line_errors.median_midpoint_distance_m},
+            {"p90_midpoint_distance_m", mt.line_errors.p90_midpoint_distance_m}}}}},
         {"octomap",
          {{"resolution_m", tree->getResolution()},
           {"occupied_voxels", m.occupancy.occupied_voxels},
@@ -123,8 +151,14 @@ int main(int argc, char** argv) {
               << " deg): precision " << 100 * m.line_map.precision << " %  recall "
               << 100 * m.line_map.recall << " % of " << m.line_map.true_length_m
               << " m of true edges; " << 100 * m.line_on_surface_fraction
-              << " % of the map line length lies on a true surface\n"
-              << "octomap: " << m.occupancy.occupied_voxels << " occupied voxels, "
+              << " % of the map line length lies on a true surface\n";
+    if (texture_edges > 0)
+      std::cout << "with the " << texture_edges << " texture edges as truth too: precision "
+                << 100 * mt.line_map.precision << " %  angle median "
+                << mt.line_errors.median_angle_deg << " deg  midpoint distance median "
+                << mt.line_errors.median_midpoint_distance_m << " m (p90 "
+                << mt.line_errors.p90_midpoint_distance_m << ")\n";
+    std::cout << "octomap: " << m.occupancy.occupied_voxels << " occupied voxels, "
               << 100 * m.occupancy.fraction << " % within " << options.voxel_tolerance_m
               << " m of a surface (mean distance " << m.occupancy.mean_distance_m << " m)\n"
               << "memory: octree " << tree->memoryUsage() << " B, " << map_lines.size()
@@ -135,16 +169,21 @@ int main(int argc, char** argv) {
     if (args.isSet("per-line")) {
       std::ostringstream os;
       os << "id,length_m,observations,landmarks,edge,angle_deg,midpoint_distance_m,"
-            "surface_distance_m,midpoint_surface_distance_m,precision\n";
+            "surface_distance_m,midpoint_surface_distance_m,precision,texture_midpoint_distance_m,"
+            "precision_with_texture_edges\n";
       for (const MapLine& l : map_lines) {
         const Segment3 s{traj.alignment.apply(l.p0), traj.alignment.apply(l.p1)};
         const LineError e = lineErrorToNearestEdge(s, edges);
         const LineMapEvaluation one = evaluateLineMap({s}, edges, options.line_distance_tol_m,
                                                       options.line_angle_tol_deg * M_PI / 180.0);
+        const LineError et = lineErrorToNearestEdge(s, all_edges);
+        const LineMapEvaluation one_t = evaluateLineMap({s}, all_edges, options.line_distance_tol_m,
+                                                        options.line_angle_tol_deg * M_PI / 180.0);
         os << l.id << "," << s.length() << "," << l.observations << "," << l.landmarks << ","
            << e.edge << "," << e.angle_deg << "," << e.midpoint_distance_m << ","
            << lineSurfaceDistance(s, surface_distance) << "," << surfaces(0.5 * (s.p0 + s.p1))
-           << "," << one.precision << "\n";
+           << "," << one.precision << "," << et.midpoint_distance_m << "," << one_t.precision
+           << "\n";
       }
       writeFileAtomically(args.get("per-line"), os.str());
     }

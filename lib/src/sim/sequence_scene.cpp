@@ -6,18 +6,33 @@
 
 #include "alvio/common/error.h"
 #include "alvio/sim/edge_projection.h"
+#include "alvio/sim/procedural_texture.h"
 
 namespace alvio::sim {
 
-std::string sceneNameFromSimInfo(const std::string& sim_info_path) {
+namespace {
+// The first capture of `pattern` in a header line of sim_info.yaml; `what` names it in errors.
+std::string headerValue(const std::string& sim_info_path, const std::regex& pattern,
+                        const std::string& what) {
   std::ifstream in(sim_info_path);
   if (!in) throw Error("cannot open " + sim_info_path);
-  const std::regex scene_line(R"(^#\s+scene:\s+(\S+))");
   for (std::string line; std::getline(in, line);) {
+    if (line.empty() || line[0] != '#') continue;
     std::smatch m;
-    if (std::regex_search(line, m, scene_line)) return m[1];
+    if (std::regex_search(line, m, pattern)) return m[1];
   }
-  throw Error(sim_info_path + ": no '# scene:' line (not written by the alvio simulator?)");
+  throw Error(sim_info_path + ": no " + what +
+              " in its header (not written by the alvio simulator?)");
+}
+}  // namespace
+
+std::string sceneNameFromSimInfo(const std::string& sim_info_path) {
+  return headerValue(sim_info_path, std::regex(R"(^#\s+scene:\s+(\S+))"), "'# scene:' line");
+}
+
+double textureDensityFromSimInfo(const std::string& sim_info_path) {
+  return parseTextureDensity(
+      headerValue(sim_info_path, std::regex(R"(\stexture:\s+(\S+))"), "'texture:' value"));
 }
 
 SceneFile loadSequenceScene(const std::string& sequence_dir, const std::string& scene_override) {

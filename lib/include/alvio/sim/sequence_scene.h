@@ -14,6 +14,10 @@ namespace alvio::sim {
 /// The scene file named in `sim_info_path`; throws alvio::Error when it names none.
 std::string sceneNameFromSimInfo(const std::string& sim_info_path);
 
+/// The texture density the sequence was rendered with (`texture:` in sim_info.yaml's header,
+/// as parseTextureDensity reads it); throws alvio::Error when the header has none.
+double textureDensityFromSimInfo(const std::string& sim_info_path);
+
 /// Load the scene of the sequence in `sequence_dir` (or `scene_override`, a name or path, when
 /// not empty) and check that its edges are those of `sequence_dir`/scene_edges.csv (same IDs,
 /// endpoints within 1e-5 m). Throws alvio::Error on any mismatch.
