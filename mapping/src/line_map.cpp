@@ -21,6 +21,7 @@ LineMapOptions LineMapOptions::load(const YamlReader& yaml, const std::string& p
   o.prune_weak_after_keyframes =
       yaml.getInt(p + "prune_weak_after_keyframes", o.prune_weak_after_keyframes);
   o.min_observations = yaml.getInt(p + "min_observations", o.min_observations);
+  o.min_landmarks = yaml.getInt(p + "min_landmarks", o.min_landmarks);
   o.min_length_m = yaml.getDouble(p + "min_length_m", o.min_length_m);
   o.max_length_m = yaml.getDouble(p + "max_length_m", o.max_length_m);
   o.max_depth_m = yaml.getDouble(p + "max_depth_m", o.max_depth_m);
@@ -33,6 +34,7 @@ LineMapOptions LineMapOptions::load(const YamlReader& yaml, const std::string& p
   check(o.index_cell_m > 0, "index_cell_m", "must be > 0");
   check(o.max_members_per_line >= 2, "max_members_per_line", "must be at least 2");
   check(o.prune_weak_after_keyframes >= 0, "prune_weak_after_keyframes", "must be >= 0");
+  check(o.min_landmarks >= 1, "min_landmarks", "must be at least 1");
   check(o.min_length_m >= 0, "min_length_m", "must be >= 0");
   check(o.max_length_m > o.min_length_m, "max_length_m", "must be greater than min_length_m");
   return o;
@@ -333,7 +335,8 @@ std::vector<MapLine> LineMap::filteredLines() const {
   std::vector<MapLine> out;
   for (const MapLine& l : lines()) {
     const double len = l.length();
-    if (l.observations < options_.min_observations) continue;
+    if (l.observations < options_.min_observations || l.landmarks < options_.min_landmarks)
+      continue;
     if (!(len >= options_.min_length_m) || len > options_.max_length_m) continue;
     if (options_.max_depth_m > 0 && l.min_depth_m > options_.max_depth_m) continue;
     out.push_back(l);

@@ -130,6 +130,20 @@ TEST(LineMap, DropsRareShortLongAndFarLinesAtSave) {
   EXPECT_EQ(map.filteredLines().size(), 2u);
 }
 
+TEST(LineMap, MinLandmarksKeepsOnlyLinesASecondTrackConfirmed) {
+  LineMapOptions o;
+  o.min_observations = 1;
+  o.min_landmarks = 2;
+  LineMap map(o);
+  map.addSegment(1, Vector3d(0, 0, 0), Vector3d(2, 0, 0), 50, kCamera);  // one track only
+  map.addSegment(2, Vector3d(0, 1, 0), Vector3d(2, 1, 0), 5, kCamera);
+  map.addSegment(3, Vector3d(0.5, 1.01, 0), Vector3d(1.8, 1.01, 0), 5, kCamera);  // confirms 2
+  const auto kept = map.filteredLines();
+  ASSERT_EQ(kept.size(), 1u);
+  EXPECT_EQ(kept.front().landmarks, 2);
+  EXPECT_EQ(kept.front().id, map.lineOf(2)->id);
+}
+
 TEST(LineMap, PrunesStaleWeakLines) {
   LineMapOptions o;
   o.prune_weak_after_keyframes = 20;
@@ -153,10 +167,12 @@ TEST(LineMap, IgnoresDegenerateSegments) {
 
 TEST(LineMap, OptionsLoadFromYamlAndNameBadKeys) {
   const YamlReader ok = YamlReader::fromString(
-      "mapping:\n  lines:\n    merge_angle_deg: 5\n    min_observations: 7\n", "test.yaml");
+      "mapping:\n  lines:\n    merge_angle_deg: 5\n    min_observations: 7\n    min_landmarks: 2\n",
+      "test.yaml");
   const LineMapOptions o = LineMapOptions::load(ok, "mapping.lines");
   EXPECT_DOUBLE_EQ(o.merge_angle_deg, 5);
   EXPECT_EQ(o.min_observations, 7);
+  EXPECT_EQ(o.min_landmarks, 2);
   EXPECT_DOUBLE_EQ(o.merge_distance_m, LineMapOptions().merge_distance_m);
   const YamlReader bad =
       YamlReader::fromString("mapping:\n  lines:\n    merge_angle_deg: 95\n", "bad.yaml");

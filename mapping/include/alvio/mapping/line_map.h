@@ -45,7 +45,11 @@ struct LineMapOptions {
   /// 0 keeps them until saving.
   int prune_weak_after_keyframes = 30;
   // Filtering when the map is saved.
-  int min_observations = 4;    ///< summed image observations of a kept line
+  int min_observations = 4;  ///< summed image observations of a kept line
+  /// Landmark IDs (independent tracks) that a kept line must have merged. 2 keeps only lines
+  /// that a second track, triangulated on its own, confirmed: on the simulator benchmark that
+  /// raises precision from 56-67 % to 88-94 % but keeps only 11-26 % of the line length.
+  int min_landmarks = 1;
   double min_length_m = 0.1;   ///< shorter lines are dropped
   double max_length_m = 30.0;  ///< longer lines are treated as triangulation outliers
   double max_depth_m = 20.0;   ///< lines never seen closer than this are outliers (<= 0: off)
