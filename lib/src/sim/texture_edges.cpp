@@ -4,6 +4,8 @@
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 
+#include "alvio/lines/line_segment.h"
+
 namespace alvio::sim {
 namespace {
 
@@ -22,33 +24,6 @@ float contrastAcross(const Texture& texture, const Eigen::Vector2f& a, const Eig
                     texture.sample(p.x() - n.x(), p.y() - n.y(), 1.0f));
   }
   return sum / samples;
-}
-
-// Clip the segment a-b to the rectangle [lo, hi] (Liang-Barsky); false when nothing is left.
-bool clipToRectangle(Eigen::Vector2d* a, Eigen::Vector2d* b, const Eigen::Vector2d& lo,
-                     const Eigen::Vector2d& hi) {
-  const Eigen::Vector2d d = *b - *a;
-  double t0 = 0, t1 = 1;
-  for (int k = 0; k < 2; ++k) {
-    const double p[2] = {-d[k], d[k]};
-    const double q[2] = {(*a)[k] - lo[k], hi[k] - (*a)[k]};
-    for (int s = 0; s < 2; ++s) {
-      if (p[s] == 0) {
-        if (q[s] < 0) return false;
-        continue;
-      }
-      const double r = q[s] / p[s];
-      if (p[s] < 0)
-        t0 = std::max(t0, r);
-      else
-        t1 = std::min(t1, r);
-    }
-  }
-  if (t0 >= t1) return false;
-  const Eigen::Vector2d start = *a + t0 * d;
-  *b = *a + t1 * d;
-  *a = start;
-  return true;
 }
 
 }  // namespace
@@ -121,9 +96,13 @@ std::vector<SceneEdge> sceneTextureEdges(const Scene& scene, const SceneAppearan
       for (int kx = kx0; kx <= kx1; ++kx) {
         const Eigen::Vector2d shift(kx * period.x(), ky * period.y());
         for (const TexelSegment& seg : segments) {
-          Eigen::Vector2d a = Eigen::Vector2d(seg.x0, seg.y0) * texel + shift;
-          Eigen::Vector2d b = Eigen::Vector2d(seg.x1, seg.y1) * texel + shift;
-          if (!clipToRectangle(&a, &b, lo, hi) || (b - a).norm() < options.min_length_m) continue;
+          LineSegment piece(Eigen::Vector2d(seg.x0, seg.y0) * texel + shift,
+                            Eigen::Vector2d(seg.x1, seg.y1) * texel + shift);
+          bool clipped = false;
+          if (!clipSegmentToRect(&piece, lo.x(), lo.y(), hi.x(), hi.y(), &clipped) ||
+              piece.length() < options.min_length_m)
+            continue;
+          const Eigen::Vector2d &a = piece.start, &b = piece.end;
           SceneEdge e;
           e.id = static_cast<int>(out.size());
           e.a = to3d(a);
