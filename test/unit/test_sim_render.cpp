@@ -138,6 +138,19 @@ double edgeCrossing(const cv::Mat1f& img, const Eigen::Vector2d& p, const Eigen:
   return 1e9;
 }
 
+// The half-height crossing (px, along the image normal) at fraction f of the 3D edge e, whose
+// projection lands at *px; false when that part of the edge is outside the image.
+bool crossingAcrossEdge(const TestView& view, const cv::Mat1f& img, const SceneEdge& e, double f,
+                        Eigen::Vector2d* px, double* crossing) {
+  Eigen::Vector2d q;
+  if (!projectToImage(view, view.T_w_c(), e.a + (e.b - e.a) * f, px, 8) ||
+      !projectToImage(view, view.T_w_c(), e.a + (e.b - e.a) * (f + 0.01), &q, 8))
+    return false;
+  const Eigen::Vector2d t = (q - *px).normalized();
+  *crossing = edgeCrossing(img, *px, Eigen::Vector2d(-t.y(), t.x()));
+  return true;
+}
+
 // The rendered corner where the two edges from `corner` towards `a` and `b` meet:
 // each edge is located (half-height crossings) 4..20 px from the corner, fitted by
 // a line, and the lines are intersected.
@@ -294,15 +307,9 @@ TEST(SimRender, SceneEdgesLandOnRenderedEdgesWithinHalfAPixel) {
   for (const SceneEdge& e : scene.edges()) {
     if (scene.objectNames()[e.object].rfind("target", 0) != 0) continue;
     for (int s = 1; s < 10; ++s) {
-      const Eigen::Vector3d X = e.a + (e.b - e.a) * (0.1 * s);
-      const Eigen::Vector3d Y = e.a + (e.b - e.a) * (0.1 * s + 0.01);
-      Eigen::Vector2d p, q;
-      if (!projectToImage(view, view.T_w_c(), X, &p, 8) ||
-          !projectToImage(view, view.T_w_c(), Y, &q, 8))
-        continue;
-      const Eigen::Vector2d t = (q - p).normalized();
-      const Eigen::Vector2d n(-t.y(), t.x());
-      const double crossing = edgeCrossing(img, p, n);
+      Eigen::Vector2d p;
+      double crossing;
+      if (!crossingAcrossEdge(view, img, e, 0.1 * s, &p, &crossing)) continue;
       ASSERT_LT(std::abs(crossing), 2.0) << "no edge near " << p.transpose();
       EXPECT_LT(std::abs(crossing), 0.5) << "edge at " << p.transpose();
       max_err = std::max(max_err, std::abs(crossing));
@@ -359,13 +366,9 @@ TEST(SimRender, TextureEdgesLandOnRenderedEdgesWithinHalfAPixel) {
       const Eigen::Vector3d X = e.a + (e.b - e.a) * (0.1 * s);
       const double depth = (X - view.T_w_c().translation()).norm();
       if (insideBorder(e.object, X) < 5 * depth / focal_px) continue;
-      const Eigen::Vector3d Y = e.a + (e.b - e.a) * (0.1 * s + 0.01);
-      Eigen::Vector2d p, q;
-      if (!projectToImage(view, view.T_w_c(), X, &p, 8) ||
-          !projectToImage(view, view.T_w_c(), Y, &q, 8))
-        continue;
-      const Eigen::Vector2d t = (q - p).normalized();
-      const double crossing = edgeCrossing(img, p, Eigen::Vector2d(-t.y(), t.x()));
+      Eigen::Vector2d p;
+      double crossing;
+      if (!crossingAcrossEdge(view, img, e, 0.1 * s, &p, &crossing)) continue;
       ASSERT_LT(std::abs(crossing), 2.0) << "no edge near " << p.transpose();
       EXPECT_LT(std::abs(crossing), 0.5) << "edge at " << p.transpose();
       sum += std::abs(crossing);
