@@ -98,6 +98,18 @@ TEST(Config, NegativeSettlingIsRejected) {
                         {"estimator.init_settle_change", "must not be negative"});
 }
 
+TEST(Config, LineMapFilterIsReadAndANegativeParallaxIsRejected) {
+  const Config c = Config::load(test::sourcePath("config/euroc.yaml"));
+  EXPECT_DOUBLE_EQ(c.estimator.line_map_max_rms_px, 0.5);
+  EXPECT_DOUBLE_EQ(c.estimator.line_map_min_parallax, 0.10);
+  const std::string dir = test::scratchDir();
+  const std::string path =
+      writeFile(dir, "parallax.yaml",
+                eurocYamlReplacing("line_map_min_parallax: 0.10", "line_map_min_parallax: -0.1"));
+  expectErrorMentioning([&] { Config::load(path); },
+                        {"estimator.line_map_min_parallax", "must not be negative"});
+}
+
 TEST(Config, NonRotationExtrinsicIsRejected) {
   const std::string dir = test::scratchDir();
   const std::string path = writeFile(dir, "rot.yaml", eurocYamlReplacing("0.0148655429818", "2.0"));

@@ -5,6 +5,7 @@
 #include <algorithm>
 
 #include "alvio/estimator/line_landmarks.h"
+#include "alvio/geometry/line_quality.h"
 #include "line_test_utils.h"
 
 using namespace alvio;
@@ -30,19 +31,26 @@ int64_t stamp(int k) {
   return 1000 + k;
 }
 
-std::vector<LineObservation, Eigen::aligned_allocator<LineObservation>> observeEdge(int k) {
+// The edge, or a parallel one shifted by `offset` (a neighbouring brick joint).
+std::vector<LineObservation, Eigen::aligned_allocator<LineObservation>> observeEdge(
+    int k, const Eigen::Vector3d& offset = Eigen::Vector3d::Zero()) {
   LineObservation o;
   o.id = 3;
-  o.start_norm = projectNormalised(cameraAt(k), kP);
-  o.end_norm = projectNormalised(cameraAt(k), kQ);
+  o.start_norm = projectNormalised(cameraAt(k), kP + offset);
+  o.end_norm = projectNormalised(cameraAt(k), kQ + offset);
   return {o};
 }
 
 // Eight frames see the edge; the first `unposed` leave the window without a pose (as before
-// initialisation), the rest with theirs. Returns what retired.
-std::vector<LineLandmark> slideThrough(int unposed) {
+// initialisation), the rest with theirs. From frame `slide_at` on, the track sees a parallel
+// edge 8 cm below instead. Returns what retired through `filter`.
+std::vector<LineLandmark> slideThrough(int unposed, const LineRetirementFilter& filter = {},
+                                       int slide_at = 8, int* filtered = nullptr) {
   LineLandmarks lines(3, LineTriangulationOptions{});
-  for (int k = 0; k < 8; ++k) lines.addFrame(stamp(k), observeEdge(k));
+  lines.setRetirementFilter(filter);
+  for (int k = 0; k < 8; ++k)
+    lines.addFrame(stamp(k), observeEdge(k, k < slide_at ? Eigen::Vector3d::Zero()
+                                                         : Eigen::Vector3d(0, 0, -0.08)));
   lines.triangulate([](int64_t ns) { return cameraAt(static_cast<int>(ns - 1000)); });
   EXPECT_TRUE(lines.landmarks().at(3).hasLine());
   for (int k = 0; k < 8; ++k) {
@@ -50,6 +58,7 @@ std::vector<LineLandmark> slideThrough(int unposed) {
     lines.removeFrame(stamp(k), k < unposed ? nullptr : &T);
   }
   EXPECT_TRUE(lines.landmarks().empty());
+  if (filtered) *filtered = lines.filteredRetirements();
   return lines.takeRetired();
 }
 
@@ -70,4 +79,33 @@ TEST(LineLandmarks, FramesWithoutPoseAreLeftOutOfTheRetirement) {
   EXPECT_LT(extentError(retired[0]), 1e-6);
   // Fewer posed views than a line needs: nothing reaches the map.
   EXPECT_TRUE(slideThrough(6).empty());
+}
+
+TEST(LineLandmarks, RetirementFilterKeepsATrackThatSlidOntoAnotherEdgeFromTheMap) {
+  LineRetirementFilter filter;
+  filter.max_reprojection_rms = 0.5 / 458.0;  // 0.5 px
+  int filtered = -1;
+  EXPECT_EQ(slideThrough(0, filter, 8, &filtered).size(), 1u);  // one edge: kept
+  EXPECT_EQ(filtered, 0);
+  EXPECT_TRUE(slideThrough(0, filter, 5, &filtered).empty());  // 5 views + 3 of another edge
+  EXPECT_EQ(filtered, 1);
+  EXPECT_EQ(slideThrough(0, {}, 5).size(), 1u);  // unfiltered, it would reach the map
+}
+
+TEST(LineLandmarks, RetirementFilterNeedsCameraMotionAcrossTheLine) {
+  LineViews views;
+  for (int k = 0; k < 8; ++k) {
+    LineView v;
+    v.T_w_c = cameraAt(k);
+    views.push_back(v);
+  }
+  const double parallax = lineCrossParallax(kP, kQ, views);
+  ASSERT_GT(parallax, 0.01);
+  LineRetirementFilter filter;
+  filter.min_cross_parallax = 0.9 * parallax;
+  EXPECT_EQ(slideThrough(0, filter).size(), 1u);
+  filter.min_cross_parallax = 1.1 * parallax;
+  int filtered = -1;
+  EXPECT_TRUE(slideThrough(0, filter, 8, &filtered).empty());
+  EXPECT_EQ(filtered, 1);
 }

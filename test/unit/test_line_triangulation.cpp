@@ -9,6 +9,7 @@
 #include "alvio/config/yaml_reader.h"
 #include "alvio/geometry/line_landmark.h"
 #include "alvio/geometry/line_projection_factor.h"
+#include "alvio/geometry/line_quality.h"
 #include "alvio/geometry/line_triangulation.h"
 #include "alvio/geometry/orthonormal_line.h"
 #include "line_test_utils.h"
@@ -263,4 +264,48 @@ TEST(LineTriangulationOptions, LoadFromYamlAndNameBadKeys) {
     EXPECT_NE(std::string(e.what()).find("bad.yaml"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("tri.min_baseline"), std::string::npos) << e.what();
   }
+}
+
+// Line quality (line_quality.h): what keeps badly supported lines out of the maps.
+
+TEST(LineQuality, ReprojectionRmsIsTheEndpointDistanceToTheProjectedLine) {
+  const Eigen::Vector3d P(-1.0, 0.0, 4.0), Q(1.0, 0.0, 4.0);  // horizontal, 4 m ahead
+  const PluckerLine line = PluckerLine::fromPoints(P, Q);
+  LineViews views(2);
+  views[1].T_w_c.translation() = Eigen::Vector3d(0.5, 0.0, 0.0);
+  for (LineView& v : views) {
+    v.start_norm = projectNormalised(v.T_w_c, P);
+    v.end_norm = projectNormalised(v.T_w_c, Q);
+  }
+  EXPECT_LT(lineReprojectionRms(line, views), 1e-12);
+  // One endpoint 0.01 off the (image x-axis) line: RMS over the four distances is 0.005.
+  views[1].end_norm.y() += 0.01;
+  double start = 0, end = 0;
+  ASSERT_TRUE(lineEndpointDistances(line, views[1], &start, &end));
+  EXPECT_NEAR(start, 0.0, 1e-12);
+  EXPECT_NEAR(end, 0.01, 1e-12);
+  EXPECT_NEAR(lineReprojectionRms(line, views), 0.005, 1e-12);
+  // Seen end-on, the line has no image line: never a good fit.
+  LineView end_on;
+  end_on.T_w_c = lookAt({-3.0, 0.0, 4.0}, P);
+  EXPECT_FALSE(lineEndpointDistances(line, end_on, &start, &end));
+  views.push_back(end_on);
+  EXPECT_TRUE(std::isinf(lineReprojectionRms(line, views)));
+}
+
+TEST(LineQuality, CrossParallaxCountsOnlyMotionAcrossTheLine) {
+  const Eigen::Vector3d P(-1.0, 0.0, 4.0), Q(1.0, 0.0, 4.0);  // along x, 4 m ahead
+  const auto viewsFrom = [](const std::vector<Eigen::Vector3d>& centres) {
+    LineViews views(centres.size());
+    for (std::size_t k = 0; k < centres.size(); ++k) views[k].T_w_c.translation() = centres[k];
+    return views;
+  };
+  // 1 m along the line, or towards it: the line's plane does not turn.
+  EXPECT_NEAR(lineCrossParallax(P, Q, viewsFrom({{0, 0, 0}, {1, 0, 0}})), 0.0, 1e-12);
+  EXPECT_NEAR(lineCrossParallax(P, Q, viewsFrom({{0, 0, 0}, {0, 0, 1}})), 0.0, 1e-12);
+  // 0.4 m across it (y), at a median distance of 4 m: about 0.1.
+  const double across = lineCrossParallax(P, Q, viewsFrom({{0, 0, 0}, {0, 0.2, 0}, {0, 0.4, 0}}));
+  EXPECT_NEAR(across, 0.1, 1e-3);
+  // A single view has no parallax.
+  EXPECT_EQ(lineCrossParallax(P, Q, viewsFrom({{0, 0, 0}})), 0.0);
 }

@@ -25,6 +25,11 @@ Estimator::Estimator(const EstimatorOptions& options, const CameraOptions& camer
       para_pose_(options.window_size + 1),
       para_speed_bias_(options.window_size + 1) {
   lines_.setObservationSigma(options.line_sigma_px / camera.intrinsics[0]);
+  LineRetirementFilter filter;
+  if (options.line_map_max_rms_px > 0)
+    filter.max_reprojection_rms = options.line_map_max_rms_px / camera.intrinsics[0];
+  filter.min_cross_parallax = options.line_map_min_parallax;
+  lines_.setRetirementFilter(filter);
   clearState();
 }
 

@@ -35,6 +35,8 @@ EstimatorOptions EstimatorOptions::load(const YamlReader& yaml, const std::strin
   o.line_min_observations = yaml.getInt(p + "line_min_observations", o.line_min_observations);
   o.line_outlier_px = yaml.getDouble(p + "line_outlier_px", o.line_outlier_px);
   o.line_triangulation = LineTriangulationOptions::load(yaml, p + "line_triangulation");
+  o.line_map_max_rms_px = yaml.getDouble(p + "line_map_max_rms_px", o.line_map_max_rms_px);
+  o.line_map_min_parallax = yaml.getDouble(p + "line_map_min_parallax", o.line_map_min_parallax);
   o.selection = FeatureSelectionOptions::load(yaml, p + "selection");
   o.init_min_parallax_px = yaml.getDouble(p + "init_min_parallax_px", o.init_min_parallax_px);
   o.init_relaxed_parallax_px =
@@ -66,6 +68,8 @@ EstimatorOptions EstimatorOptions::load(const YamlReader& yaml, const std::strin
   if (o.line_sigma_px <= 0) throw Error(yaml.where(p + "line_sigma_px") + " must be positive");
   if (o.line_min_observations < 2)
     throw Error(yaml.where(p + "line_min_observations") + " must be at least 2");
+  if (o.line_map_min_parallax < 0)
+    throw Error(yaml.where(p + "line_map_min_parallax") + " must not be negative (0: no limit)");
   if (o.imu_noise_scale <= 0) throw Error(yaml.where(p + "imu_noise_scale") + " must be positive");
   if (o.robust_loss != "cauchy" && o.robust_loss != "huber" && o.robust_loss != "none")
     throw Error(yaml.where(p + "robust_loss") + ": unknown loss '" + o.robust_loss +

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "alvio/geometry/line_projection_factor.h"
+#include "alvio/geometry/line_quality.h"
 #include "alvio/geometry/orthonormal_line.h"
 #include "alvio/geometry/orthonormal_line_manifold.h"
 
@@ -42,28 +43,32 @@ void LineLandmarks::removeFrame(int64_t frame_ns, const Eigen::Isometry3d* T_w_c
       ++it;
       continue;
     }
-    // Retire: one refinement over every observation of the track, for the map.
-    const LineViews& views = history_[l.id];
-    if (usableForRetirement(l, views)) {
-      PluckerLine line = l.line_w;
-      if (refineLine(views, triangulation_, &line)) {
-        LineLandmark retired = l;
-        retired.setLine(line, LineLandmarkStatus::kOptimised);
-        retired.has_extent = false;
-        Eigen::Vector3d a, b;
-        if (lineExtent(line, views, &a, &b, triangulation_)) {
-          retired.start_w = a;
-          retired.end_w = b;
-          retired.has_extent = true;
-          retired.direction_std_deg = directionStdDeg(line, views, sigma_);
-          retired.track_observations = static_cast<int>(views.size());
-          retired_.push_back(retired);
-        }
-      }
-    }
+    retire(l, history_[l.id]);
     history_.erase(l.id);
     it = landmarks_.erase(it);
   }
+}
+
+void LineLandmarks::retire(const LineLandmark& l, const LineViews& views) {
+  // One refinement over every observation of the track, for the map.
+  if (!usableForRetirement(l, views)) return;
+  PluckerLine line = l.line_w;
+  Eigen::Vector3d a, b;
+  if (!refineLine(views, triangulation_, &line) || !lineExtent(line, views, &a, &b, triangulation_))
+    return;
+  if (lineReprojectionRms(line, views) > filter_.max_reprojection_rms ||
+      lineCrossParallax(a, b, views) < filter_.min_cross_parallax) {
+    ++filtered_retirements_;
+    return;
+  }
+  LineLandmark retired = l;
+  retired.setLine(line, LineLandmarkStatus::kOptimised);
+  retired.start_w = a;
+  retired.end_w = b;
+  retired.has_extent = true;
+  retired.direction_std_deg = directionStdDeg(line, views, sigma_);
+  retired.track_observations = static_cast<int>(views.size());
+  retired_.push_back(retired);
 }
 
 bool LineLandmarks::usableForRetirement(const LineLandmark& l, const LineViews& views) const {

@@ -36,6 +36,12 @@ struct EstimatorOptions {
   int line_min_observations = 3;  ///< window observations before a line is used
   double line_outlier_px = 5.0;   ///< lines with a larger mean endpoint error are removed
   LineTriangulationOptions line_triangulation;
+  /// A retired line reaches the maps only if its whole track fits it within this RMS
+  /// endpoint distance [px] (<= 0: no limit) and the cameras moved across it by at least this
+  /// fraction of its distance (lineCrossParallax; 0: no limit). Tuned on the rendered
+  /// benchmark (docs/truth_evaluation.md); the trajectory does not depend on them.
+  double line_map_max_rms_px = 0.5;
+  double line_map_min_parallax = 0.10;
 
   /// Sensitivity-based selection and adaptive weighting (estimator.selection).
   FeatureSelectionOptions selection;

@@ -6,6 +6,7 @@
 // frame never re-parameterises them.
 
 #include <functional>
+#include <limits>
 #include <map>
 #include <vector>
 
@@ -14,6 +15,16 @@
 #include "alvio/geometry/line_triangulation.h"
 
 namespace alvio {
+
+/// Which retired lines are handed to the maps: a track whose observations do not fit one line
+/// (it slid onto a neighbouring edge) or that the cameras barely moved across is placed by
+/// noise. The defaults let every line through.
+struct LineRetirementFilter {
+  /// Largest RMS endpoint-to-line distance over the track (normalised image units).
+  double max_reprojection_rms = std::numeric_limits<double>::infinity();
+  /// Smallest cross parallax (lineCrossParallax: baseline across the line over distance).
+  double min_cross_parallax = 0;
+};
 
 class LineLandmarks {
  public:
@@ -26,7 +37,8 @@ class LineLandmarks {
       const std::vector<LineObservation, Eigen::aligned_allocator<LineObservation>>& lines);
   /// A frame leaves the window: its observations move to the lines' history with the frame's
   /// final camera pose T_w_c. A line left with no window observation retires: it is refined
-  /// over its whole history (all its observations, poses fixed) and queued for takeRetired().
+  /// over its whole history (all its observations, poses fixed) and, if it passes the
+  /// retirement filter, queued for takeRetired().
   /// `T_w_c` null: the frame has no estimated pose (before initialisation), so its
   /// observations are dropped instead of kept for the retirement refinement.
   void removeFrame(int64_t frame_ns, const Eigen::Isometry3d* T_w_c);
@@ -55,11 +67,15 @@ class LineLandmarks {
   /// Direction uncertainty [deg] of a line from views (residual noise sigma in normalised units).
   static double directionStdDeg(const PluckerLine& line, const LineViews& views, double sigma);
   void setObservationSigma(double sigma_normalised) { sigma_ = sigma_normalised; }
+  void setRetirementFilter(const LineRetirementFilter& filter) { filter_ = filter; }
+  /// Retired lines the filter kept from the maps, since construction.
+  int filteredRetirements() const { return filtered_retirements_; }
 
   std::map<int, LineLandmark>& landmarks() { return landmarks_; }
   const std::map<int, LineLandmark>& landmarks() const { return landmarks_; }
 
  private:
+  void retire(const LineLandmark& l, const LineViews& views);
   bool usableForRetirement(const LineLandmark& l, const LineViews& views) const;
 
   int min_observations_;
@@ -69,6 +85,8 @@ class LineLandmarks {
   std::map<int, LineViews> history_;       // observations of frames that left the window
   std::vector<LineLandmark> retired_;
   double sigma_ = 1.5 / 458.0;
+  LineRetirementFilter filter_;
+  int filtered_retirements_ = 0;
 };
 
 }  // namespace alvio

@@ -1,0 +1,30 @@
+#pragma once
+// How well a triangulated line is supported by its views: how consistently the observed
+// segments fit one 3D line, and how much the cameras moved across it. A track that slid onto
+// a neighbouring edge leaves a large residual; a line seen only while the camera moved along
+// it (or from far away) is placed by noise. Used to keep such lines out of the maps.
+
+#include <Eigen/Core>
+
+#include "alvio/geometry/line_triangulation.h"
+#include "alvio/geometry/plucker_line.h"
+
+namespace alvio {
+
+/// Distances of a view's observed endpoints to the projection of `line_w` (normalised image
+/// units). False when the line projects to a point in that view (seen end-on).
+bool lineEndpointDistances(const PluckerLine& line_w, const LineView& view, double* start,
+                           double* end);
+
+/// Root mean square of every view's endpoint distances (normalised units); infinity when the
+/// line projects to a point in some view, 0 without views.
+double lineReprojectionRms(const PluckerLine& line_w, const LineViews& views);
+
+/// Parallax of the segment start_w..end_w in its views: the spread of the camera centres along
+/// the one direction that changes how the line looks (perpendicular to the line and to the mean
+/// viewing ray of its midpoint), divided by the median camera-to-midpoint distance. A
+/// dimensionless baseline-over-depth; motion along the line or the ray adds nothing.
+double lineCrossParallax(const Eigen::Vector3d& start_w, const Eigen::Vector3d& end_w,
+                         const LineViews& views);
+
+}  // namespace alvio

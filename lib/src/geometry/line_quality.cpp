@@ -1,0 +1,59 @@
+#include "alvio/geometry/line_quality.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+namespace alvio {
+
+bool lineEndpointDistances(const PluckerLine& line_w, const LineView& view, double* start,
+                           double* end) {
+  const Eigen::Vector3d l = line_w.transformed(view.T_w_c.inverse()).normalisedImageLine();
+  const double norm = l.head<2>().norm();
+  if (norm < 1e-12) return false;
+  *start = std::abs(view.start_norm.homogeneous().dot(l)) / norm;
+  *end = std::abs(view.end_norm.homogeneous().dot(l)) / norm;
+  return true;
+}
+
+double lineReprojectionRms(const PluckerLine& line_w, const LineViews& views) {
+  if (views.empty()) return 0;
+  double sum = 0;
+  for (const LineView& v : views) {
+    double a = 0, b = 0;
+    if (!lineEndpointDistances(line_w, v, &a, &b)) return std::numeric_limits<double>::infinity();
+    sum += a * a + b * b;
+  }
+  return std::sqrt(sum / (2.0 * static_cast<double>(views.size())));
+}
+
+double lineCrossParallax(const Eigen::Vector3d& start_w, const Eigen::Vector3d& end_w,
+                         const LineViews& views) {
+  if (views.size() < 2 || (end_w - start_w).norm() <= 0) return 0;
+  const Eigen::Vector3d mid = 0.5 * (start_w + end_w);
+  const Eigen::Vector3d u = (end_w - start_w).normalized();
+  Eigen::Vector3d mean_ray = Eigen::Vector3d::Zero();
+  std::vector<double> distances;
+  distances.reserve(views.size());
+  for (const LineView& v : views) {
+    const Eigen::Vector3d ray = mid - v.T_w_c.translation();
+    distances.push_back(ray.norm());
+    if (distances.back() > 0) mean_ray += ray / distances.back();
+  }
+  mean_ray -= u * u.dot(mean_ray);
+  if (mean_ray.norm() < 1e-9) return 0;  // seen end-on
+  // Moving along n (normal of the plane spanned by the line and the ray) turns that plane.
+  const Eigen::Vector3d n = u.cross(mean_ray.normalized());
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (const LineView& v : views) {
+    const double x = n.dot(v.T_w_c.translation());
+    lo = std::min(lo, x);
+    hi = std::max(hi, x);
+  }
+  auto median = distances.begin() + static_cast<std::ptrdiff_t>(distances.size() / 2);
+  std::nth_element(distances.begin(), median, distances.end());
+  return *median > 0 ? (hi - lo) / *median : 0;
+}
+
+}  // namespace alvio
