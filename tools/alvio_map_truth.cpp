@@ -44,7 +44,8 @@ int main(int argc, char** argv) {
   args.option("voxel-tolerance", "voxel centre to a true surface (m); default 2 voxels", "");
   args.flag("no-texture-edges", "judge lines against the geometry's edges only (faster)");
   args.option("json", "write every figure to this JSON file");
-  args.option("per-line", "write each map line's error (true world) to this CSV file");
+  args.option("per-line",
+              "write each map line's error and endpoints (true world) to this CSV file");
   try {
     if (!args.parse(argc, argv)) return 0;
     if (args.positional().size() != 2) throw Error("give RUN_DIR and SEQUENCE_DIR");
@@ -170,7 +171,7 @@ int main(int argc, char** argv) {
       std::ostringstream os;
       os << "id,length_m,observations,landmarks,edge,angle_deg,midpoint_distance_m,"
             "surface_distance_m,midpoint_surface_distance_m,precision,texture_midpoint_distance_m,"
-            "precision_with_texture_edges\n";
+            "precision_with_texture_edges,x0,y0,z0,x1,y1,z1\n";
       for (const MapLine& l : map_lines) {
         const Segment3 s{traj.alignment.apply(l.p0), traj.alignment.apply(l.p1)};
         const LineError e = lineErrorToNearestEdge(s, edges);
@@ -182,8 +183,10 @@ int main(int argc, char** argv) {
         os << l.id << "," << s.length() << "," << l.observations << "," << l.landmarks << ","
            << e.edge << "," << e.angle_deg << "," << e.midpoint_distance_m << ","
            << lineSurfaceDistance(s, surface_distance) << "," << surfaces(0.5 * (s.p0 + s.p1))
-           << "," << one.precision << "," << et.midpoint_distance_m << "," << one_t.precision
-           << "\n";
+           << "," << one.precision << "," << et.midpoint_distance_m << "," << one_t.precision;
+        for (const Eigen::Vector3d& p : {s.p0, s.p1})
+          os << "," << p.x() << "," << p.y() << "," << p.z();
+        os << "\n";
       }
       writeFileAtomically(args.get("per-line"), os.str());
     }
