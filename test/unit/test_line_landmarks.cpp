@@ -58,7 +58,11 @@ std::vector<LineLandmark> slideThrough(int unposed, const LineRetirementFilter& 
     lines.removeFrame(stamp(k), k < unposed ? nullptr : &T);
   }
   EXPECT_TRUE(lines.landmarks().empty());
-  if (filtered) *filtered = lines.filteredRetirements();
+  if (filtered) {
+    const LineRetirementCounts& c = lines.retirementCounts();
+    *filtered = c.held_back_fit + c.held_back_parallax;
+    EXPECT_EQ(c.retired + *filtered, 1) << "one line left the window";
+  }
   return lines.takeRetired();
 }
 

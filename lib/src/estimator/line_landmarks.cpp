@@ -56,11 +56,15 @@ void LineLandmarks::retire(const LineLandmark& l, const LineViews& views) {
   Eigen::Vector3d a, b;
   if (!refineLine(views, triangulation_, &line) || !lineExtent(line, views, &a, &b, triangulation_))
     return;
-  if (lineReprojectionRms(line, views) > filter_.max_reprojection_rms ||
-      lineCrossParallax(a, b, views) < filter_.min_cross_parallax) {
-    ++filtered_retirements_;
+  if (lineReprojectionRms(line, views) > filter_.max_reprojection_rms) {
+    ++counts_.held_back_fit;
     return;
   }
+  if (lineCrossParallax(a, b, views) < filter_.min_cross_parallax) {
+    ++counts_.held_back_parallax;
+    return;
+  }
+  ++counts_.retired;
   LineLandmark retired = l;
   retired.setLine(line, LineLandmarkStatus::kOptimised);
   retired.start_w = a;

@@ -216,6 +216,7 @@ RunResult runOffline(SensorSource& source, const Config& config, const RunOption
   result.resets = pipeline.estimator().resetCount();
   result.dropped_images = pipeline.droppedImages() + images_of_old_clock;
   result.dropped_imu = pipeline.estimator().droppedImu();
+  result.line_retirement = pipeline.estimator().lineRetirementCounts();
   result.poses = result.trajectory.size();
 
   writeTumTrajectory((fs::path(options.out_dir) / "trajectory.tum").string(), result.trajectory);
@@ -232,6 +233,9 @@ RunResult runOffline(SensorSource& source, const Config& config, const RunOption
   summary["dropped_images"] = result.dropped_images;
   summary["dropped_imu"] = result.dropped_imu;
   summary["resets"] = result.resets;
+  summary["lines_retired"] = result.line_retirement.retired;
+  summary["lines_held_back_fit"] = result.line_retirement.held_back_fit;
+  summary["lines_held_back_parallax"] = result.line_retirement.held_back_parallax;
   summary["interrupted"] = result.interrupted;
   for (const auto& s : result.timing.summary())
     summary["timing_ms"][s.stage] = {

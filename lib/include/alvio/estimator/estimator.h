@@ -122,6 +122,8 @@ class Estimator {
   /// Lines that left the window since the last call, each refined over its whole track
   /// with the final poses of every frame that saw it (for maps). Output frame.
   LineSegments3 takeRetiredLines();
+  /// Retired lines handed to the maps and held back by the map filter, since construction.
+  const LineRetirementCounts& lineRetirementCounts() const { return lines_.retirementCounts(); }
   int resetCount() const { return reset_count_; }
   /// IMU clock jumps back seen by addImu (each also counted as a reset).
   int clockJumps() const { return clock_jumps_; }

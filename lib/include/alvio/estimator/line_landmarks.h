@@ -26,6 +26,13 @@ struct LineRetirementFilter {
   double min_cross_parallax = 0;
 };
 
+/// What became of the lines that left the window with enough observations and an extent.
+struct LineRetirementCounts {
+  int retired = 0;             ///< refined over their track and handed to the maps
+  int held_back_fit = 0;       ///< track fits worse than max_reprojection_rms
+  int held_back_parallax = 0;  ///< fit fine, but under min_cross_parallax
+};
+
 class LineLandmarks {
  public:
   /// `min_observations`: window observations a line needs before it is triangulated and used.
@@ -68,8 +75,8 @@ class LineLandmarks {
   static double directionStdDeg(const PluckerLine& line, const LineViews& views, double sigma);
   void setObservationSigma(double sigma_normalised) { sigma_ = sigma_normalised; }
   void setRetirementFilter(const LineRetirementFilter& filter) { filter_ = filter; }
-  /// Retired lines the filter kept from the maps, since construction.
-  int filteredRetirements() const { return filtered_retirements_; }
+  /// Since construction (resets included).
+  const LineRetirementCounts& retirementCounts() const { return counts_; }
 
   std::map<int, LineLandmark>& landmarks() { return landmarks_; }
   const std::map<int, LineLandmark>& landmarks() const { return landmarks_; }
@@ -86,7 +93,7 @@ class LineLandmarks {
   std::vector<LineLandmark> retired_;
   double sigma_ = 1.5 / 458.0;
   LineRetirementFilter filter_;
-  int filtered_retirements_ = 0;
+  LineRetirementCounts counts_;
 };
 
 }  // namespace alvio

@@ -54,7 +54,8 @@ struct RunResult {
   TimingLog timing;
   std::optional<InitializationQuality> initialization;
   std::optional<EvaluationResult> evaluation;  ///< SE(3) ATE, when ground truth exists
-  double observer_ms = 0;  ///< wall time spent in observers' onStart/onImu/onFrame
+  double observer_ms = 0;                ///< wall time spent in observers' onStart/onImu/onFrame
+  LineRetirementCounts line_retirement;  ///< lines handed to the maps or held back
 };
 
 RunResult runOffline(SensorSource& source, const Config& config, const RunOptions& options);
