@@ -49,6 +49,7 @@ class EstimatorNodelet : public GuardedNodelet {
     wake_.notify_all();
     if (worker_.joinable()) worker_.join();
     writeTrajectory();
+    logLineRetirement();
   }
 
  private:
@@ -386,6 +387,21 @@ class EstimatorNodelet : public GuardedNodelet {
       NODELET_INFO(
           "no frame for %.1f s: the landmarks of the window's %zu keyframes went to the map",
           flush_after_s_, keyframes.size());
+  }
+
+  // What the map filter let through, as alvio_run reports it (since the last restart).
+  void logLineRetirement() const {
+    if (!estimator_) return;
+    const alvio::LineRetirementCounts& c = estimator_->lineRetirementCounts();
+    if (c.retired + c.held_back_fit + c.held_back_parallax == 0) return;
+    NODELET_INFO("lines for the map: %s",
+                 alvio::describeLineRetirement(c, config_.estimator.line_map_max_rms_px,
+                                               config_.estimator.line_map_min_parallax)
+                     .c_str());
+    if (alvio::fitLimitLooksTooTight(c))
+      NODELET_WARN(
+          "most line tracks fit worse than estimator.line_map_max_rms_px; if this camera's line "
+          "endpoints are noisier, raise it");
   }
 
   void writeTrajectory(const std::string& name = "trajectory.tum") {

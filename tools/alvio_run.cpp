@@ -113,20 +113,14 @@ int main(int argc, char** argv) {
                 << " %, gravity error " << q.gravity_error_deg << " deg\n";
     }
     const LineRetirementCounts& lr = r.line_retirement;
-    const int line_tracks = lr.retired + lr.held_back_fit + lr.held_back_parallax;
-    if (line_tracks > 0) {
-      std::ostringstream limits;  // own stream: the fixed format above must not leak into it
-      limits << lr.held_back_fit << " fit worse than " << config.estimator.line_map_max_rms_px
-             << " px RMS, " << lr.held_back_parallax << " with cross parallax under "
-             << config.estimator.line_map_min_parallax;
-      std::cout << "lines for the maps: " << lr.retired << " of " << line_tracks
-                << " retired tracks; held back: " << limits.str() << "\n";
-      // On the rendered benchmark 40-50 % fail the fit; a camera whose line endpoints are much
-      // noisier fails nearly all. Say so rather than leave the line map nearly empty.
-      if (4 * lr.held_back_fit > 3 * line_tracks)
-        std::cout << "note: most line tracks fit worse than estimator.line_map_max_rms_px; if "
-                     "this camera's line endpoints are noisier, raise it\n";
-    }
+    if (lr.retired + lr.held_back_fit + lr.held_back_parallax > 0)
+      std::cout << "lines for the maps: "
+                << describeLineRetirement(lr, config.estimator.line_map_max_rms_px,
+                                          config.estimator.line_map_min_parallax)
+                << "\n";
+    if (fitLimitLooksTooTight(lr))
+      std::cout << "note: most line tracks fit worse than estimator.line_map_max_rms_px; if "
+                   "this camera's line endpoints are noisier, raise it\n";
     std::cout << r.timing.summaryTable();
     std::cout << "outputs in " << options.out_dir << "\n";
     if (logger && logger->logger()) {

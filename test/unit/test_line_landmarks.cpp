@@ -112,3 +112,20 @@ TEST(LineLandmarks, RetirementFilterNeedsCameraMotionAcrossTheLine) {
   EXPECT_EQ(counts.held_back_parallax, 1);
   EXPECT_EQ(counts.retired + counts.held_back_fit, 0);
 }
+
+TEST(LineLandmarks, RetirementSummaryNamesTheLimitsAndWarnsWhenMostTracksFailTheFit) {
+  LineRetirementCounts c;
+  c.retired = 43;
+  c.held_back_fit = 73;
+  c.held_back_parallax = 32;
+  EXPECT_EQ(describeLineRetirement(c, 0.5, 0.1),
+            "43 of 148 retired tracks; held back: 73 fit worse than 0.5 px RMS, 32 with cross "
+            "parallax under 0.1");
+  EXPECT_FALSE(fitLimitLooksTooTight(c));  // about half, as on the rendered benchmark
+  c.held_back_fit = 300;                   // 300 of 375: 80 %
+  EXPECT_TRUE(fitLimitLooksTooTight(c));
+  // Too few tracks to judge (the first seconds after initialisation fit badly anyway).
+  const LineRetirementCounts early{5, 46, 1};
+  EXPECT_FALSE(fitLimitLooksTooTight(early));
+  EXPECT_FALSE(fitLimitLooksTooTight(LineRetirementCounts{}));
+}
