@@ -393,15 +393,12 @@ class EstimatorNodelet : public GuardedNodelet {
   void logLineRetirement() const {
     if (!estimator_) return;
     const alvio::LineRetirementCounts& c = estimator_->lineRetirementCounts();
-    if (c.retired + c.held_back_fit + c.held_back_parallax == 0) return;
+    if (c.tracks() == 0) return;
     NODELET_INFO("lines for the map: %s",
                  alvio::describeLineRetirement(c, config_.estimator.line_map_max_rms_px,
                                                config_.estimator.line_map_min_parallax)
                      .c_str());
-    if (alvio::fitLimitLooksTooTight(c))
-      NODELET_WARN(
-          "most line tracks fit worse than estimator.line_map_max_rms_px; if this camera's line "
-          "endpoints are noisier, raise it");
+    if (alvio::fitLimitLooksTooTight(c)) NODELET_WARN("%s", alvio::kFitLimitHint);
   }
 
   void writeTrajectory(const std::string& name = "trajectory.tum") {

@@ -113,14 +113,12 @@ int main(int argc, char** argv) {
                 << " %, gravity error " << q.gravity_error_deg << " deg\n";
     }
     const LineRetirementCounts& lr = r.line_retirement;
-    if (lr.retired + lr.held_back_fit + lr.held_back_parallax > 0)
+    if (lr.tracks() > 0)
       std::cout << "lines for the maps: "
                 << describeLineRetirement(lr, config.estimator.line_map_max_rms_px,
                                           config.estimator.line_map_min_parallax)
                 << "\n";
-    if (fitLimitLooksTooTight(lr))
-      std::cout << "note: most line tracks fit worse than estimator.line_map_max_rms_px; if "
-                   "this camera's line endpoints are noisier, raise it\n";
+    if (fitLimitLooksTooTight(lr)) std::cout << "note: " << kFitLimitHint << "\n";
     std::cout << r.timing.summaryTable();
     std::cout << "outputs in " << options.out_dir << "\n";
     if (logger && logger->logger()) {

@@ -17,6 +17,7 @@
 #include "alvio/estimator/factors/point_projection_factor.h"
 #include "alvio/estimator/pose_manifold.h"
 #include "alvio/geometry/line_projection_factor.h"
+#include "alvio/geometry/line_quality.h"
 #include "alvio/geometry/line_triangulation.h"
 #include "alvio/geometry/orthonormal_line.h"
 #include "alvio/geometry/orthonormal_line_manifold.h"
@@ -373,14 +374,14 @@ void Estimator::removeLineOutliers() {
     bool behind = false;
     for (const auto& [ns, obs] : l.observations) {
       const PluckerLine lc = l.line_w.transformed(cameraPose(ns).inverse());
-      const Eigen::Vector3d line = lc.normalisedImageLine();
-      const double norm = line.head<2>().norm();
-      if (norm < 1e-12) {
-        behind = true;
+      double d_start = 0, d_end = 0;
+      if (!imageLineEndpointDistances(lc, obs.start_norm, obs.end_norm, &d_start, &d_end)) {
+        behind = true;  // seen end-on
         break;
       }
+      err += 0.5 * d_start * f;
+      err += 0.5 * d_end * f;
       for (const Eigen::Vector2d& e : {obs.start_norm, obs.end_norm}) {
-        err += 0.5 * std::abs(Eigen::Vector3d(e.x(), e.y(), 1).dot(line)) / norm * f;
         double s_line = 0, t_ray = 0;
         if (closestPointOnLineToRay(lc, Eigen::Vector3d::Zero(), Eigen::Vector3d(e.x(), e.y(), 1),
                                     &s_line, &t_ray))

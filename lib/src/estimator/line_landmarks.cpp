@@ -14,15 +14,14 @@ namespace alvio {
 std::string describeLineRetirement(const LineRetirementCounts& counts, double max_rms_px,
                                    double min_parallax) {
   std::ostringstream os;
-  os << counts.retired << " of "
-     << counts.retired + counts.held_back_fit + counts.held_back_parallax
+  os << counts.retired << " of " << counts.tracks()
      << " retired tracks; held back: " << counts.held_back_fit << " fit worse than " << max_rms_px
      << " px RMS, " << counts.held_back_parallax << " with cross parallax under " << min_parallax;
   return os.str();
 }
 
 bool fitLimitLooksTooTight(const LineRetirementCounts& counts) {
-  const int total = counts.retired + counts.held_back_fit + counts.held_back_parallax;
+  const int total = counts.tracks();
   // Right after initialisation the poses are rough and most tracks fail (sim_MH_05, first
   // 300 frames: 46 of 52), so only a long run's counts say something about the camera.
   return total >= kMinTracksToJudgeTheFitLimit && 4 * counts.held_back_fit > 3 * total;

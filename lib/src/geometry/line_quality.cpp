@@ -7,14 +7,20 @@
 
 namespace alvio {
 
-bool lineEndpointDistances(const PluckerLine& line_w, const LineView& view, double* start,
-                           double* end) {
-  const Eigen::Vector3d l = line_w.transformed(view.T_w_c.inverse()).normalisedImageLine();
+bool imageLineEndpointDistances(const PluckerLine& line_c, const Eigen::Vector2d& start_norm,
+                                const Eigen::Vector2d& end_norm, double* start, double* end) {
+  const Eigen::Vector3d& l = line_c.normalisedImageLine();
   const double norm = l.head<2>().norm();
   if (norm < 1e-12) return false;
-  *start = std::abs(view.start_norm.homogeneous().dot(l)) / norm;
-  *end = std::abs(view.end_norm.homogeneous().dot(l)) / norm;
+  *start = std::abs(start_norm.homogeneous().dot(l)) / norm;
+  *end = std::abs(end_norm.homogeneous().dot(l)) / norm;
   return true;
+}
+
+bool lineEndpointDistances(const PluckerLine& line_w, const LineView& view, double* start,
+                           double* end) {
+  return imageLineEndpointDistances(line_w.transformed(view.T_w_c.inverse()), view.start_norm,
+                                    view.end_norm, start, end);
 }
 
 double lineReprojectionRms(const PluckerLine& line_w, const LineViews& views) {

@@ -32,6 +32,7 @@ struct LineRetirementCounts {
   int retired = 0;             ///< refined over their track and handed to the maps
   int held_back_fit = 0;       ///< track fits worse than max_reprojection_rms
   int held_back_parallax = 0;  ///< fit fine, but under min_cross_parallax
+  int tracks() const { return retired + held_back_fit + held_back_parallax; }
 };
 
 /// "43 of 148 retired tracks; held back: 73 fit worse than 0.5 px RMS, 32 with cross
@@ -43,6 +44,10 @@ std::string describeLineRetirement(const LineRetirementCounts& counts, double ma
 /// noisier fails nearly all and needs a looser limit.
 inline constexpr int kMinTracksToJudgeTheFitLimit = 200;
 bool fitLimitLooksTooTight(const LineRetirementCounts& counts);
+/// What to tell the user when fitLimitLooksTooTight.
+inline constexpr const char* kFitLimitHint =
+    "most line tracks fit worse than estimator.line_map_max_rms_px; if this camera's line "
+    "endpoints are noisier, raise it";
 
 class LineLandmarks {
  public:

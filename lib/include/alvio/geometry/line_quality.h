@@ -11,8 +11,11 @@
 
 namespace alvio {
 
-/// Distances of a view's observed endpoints to the projection of `line_w` (normalised image
-/// units). False when the line projects to a point in that view (seen end-on).
+/// Distances of observed endpoints (normalised image coordinates) to the image of `line_c`,
+/// a line in that camera's frame. False when it projects to a point (seen end-on).
+bool imageLineEndpointDistances(const PluckerLine& line_c, const Eigen::Vector2d& start_norm,
+                                const Eigen::Vector2d& end_norm, double* start, double* end);
+/// The same for a world line and a view.
 bool lineEndpointDistances(const PluckerLine& line_w, const LineView& view, double* start,
                            double* end);
 
