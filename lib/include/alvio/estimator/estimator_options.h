@@ -13,7 +13,7 @@ class YamlReader;
 struct EstimatorOptions {
   int window_size = 10;                ///< keyframes in the window (plus the newest frame)
   double keyframe_parallax_px = 10;    ///< mean parallax that makes a frame a keyframe
-  int max_iterations = 8;              ///< Ceres iterations per frame (no time limit: determinism)
+  int max_iterations = 5;              ///< Ceres iterations per frame (no time limit: determinism)
   int num_threads = 1;                 ///< Ceres threads
   double point_sigma_px = 1.5;         ///< reprojection noise of points
   std::string robust_loss = "cauchy";  ///< cauchy | huber | none
