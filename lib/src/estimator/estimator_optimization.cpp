@@ -114,6 +114,23 @@ double* Estimator::lineBlock(std::size_t k) {
   return &para_landmarks_[num_point_params_ + OrthonormalLine::kParameterSize * k];
 }
 
+PointProjectionFactor* Estimator::newPointFactor(const Eigen::Vector2d& obs_i,
+                                                 const Eigen::Vector2d& obs_j) const {
+  const double sqrt_info = point_scale_ * camera_.intrinsics[0] / options_.point_sigma_px;
+  return new PointProjectionFactor(obs_i, obs_j, T_b_c_, sqrt_info);
+}
+
+LineProjectionFactor* Estimator::newLineFactor(const LineLandmarkObservation& obs) const {
+  const double sqrt_info = line_scale_ * camera_.intrinsics[0] / options_.line_sigma_px;
+  return new LineProjectionFactor(obs.start_norm, obs.end_norm, T_b_c_, sqrt_info);
+}
+
+std::map<int64_t, int> Estimator::windowSlots() const {
+  std::map<int64_t, int> slot;
+  for (int i = 0; i <= frame_count_; ++i) slot[header_ns_[i]] = i;
+  return slot;
+}
+
 void Estimator::parametersToStates() {
   // The window is only constrained up to a yaw and a translation (plus the prior): keep the
   // oldest keyframe's yaw and position where they were, so the output does not wander.
@@ -185,7 +202,6 @@ void Estimator::optimize(FrameTiming* timing, int max_iterations) {
                              para_pose_[i].data(), para_speed_bias_[i].data(), para_pose_[j].data(),
                              para_speed_bias_[j].data());
   }
-  const double sqrt_info = point_scale_ * camera_.intrinsics[0] / options_.point_sigma_px;
   int index = -1;
   for (const auto& [id, l] : points_.landmarks()) {
     if (!l.usable(W_)) continue;
@@ -196,17 +212,15 @@ void Estimator::optimize(FrameTiming* timing, int max_iterations) {
     if (l.sightings.size() > 1) ordering->AddElementToGroup(inverseDepthBlock(index), 0);
     for (std::size_t k = 1; k < l.sightings.size(); ++k) {
       const int j = i + static_cast<int>(k);
-      problem.AddResidualBlock(
-          new PointProjectionFactor(obs_i, l.sightings[k].xy1.head<2>(), T_b_c_, sqrt_info),
-          loss.get(), para_pose_[i].data(), para_pose_[j].data(), inverseDepthBlock(index));
+      problem.AddResidualBlock(newPointFactor(obs_i, l.sightings[k].xy1.head<2>()), loss.get(),
+                               para_pose_[i].data(), para_pose_[j].data(),
+                               inverseDepthBlock(index));
     }
   }
   // Lines: one factor per window observation, on the observing frame's pose.
   if (options_.use_lines) {
     auto* line_manifold = new OrthonormalLineManifold();  // owned by the problem
-    const double line_sqrt_info = line_scale_ * camera_.intrinsics[0] / options_.line_sigma_px;
-    std::map<int64_t, int> slot;
-    for (int i = 0; i <= frame_count_; ++i) slot[header_ns_[i]] = i;
+    const std::map<int64_t, int> slot = windowSlots();
     std::size_t k = 0;
     for (const auto& [id, l] : lines_.landmarks()) {
       if (!lines_.usable(l)) continue;
@@ -214,11 +228,9 @@ void Estimator::optimize(FrameTiming* timing, int max_iterations) {
       if (!lineSelected(l)) continue;
       problem.AddParameterBlock(line_block, OrthonormalLine::kParameterSize, line_manifold);
       ordering->AddElementToGroup(line_block, 0);
-      for (const auto& [ns, obs] : l.observations) {
-        problem.AddResidualBlock(
-            new LineProjectionFactor(obs.start_norm, obs.end_norm, T_b_c_, line_sqrt_info),
-            loss.get(), para_pose_[slot.at(ns)].data(), line_block);
-      }
+      for (const auto& [ns, obs] : l.observations)
+        problem.AddResidualBlock(newLineFactor(obs), loss.get(), para_pose_[slot.at(ns)].data(),
+                                 line_block);
     }
   }
 
@@ -291,7 +303,6 @@ void Estimator::marginalize() {
                              {para_pose_[0].data(), para_speed_bias_[0].data(),
                               para_pose_[1].data(), para_speed_bias_[1].data()},
                              {0, 1});
-    const double sqrt_info = point_scale_ * camera_.intrinsics[0] / options_.point_sigma_px;
     int index = -1;
     for (const auto& [id, l] : points_.landmarks()) {
       if (!l.usable(W_)) continue;
@@ -300,25 +311,21 @@ void Estimator::marginalize() {
       const Eigen::Vector2d obs_i = l.sightings.front().xy1.head<2>();
       for (std::size_t k = 1; k < l.sightings.size(); ++k)
         info->addResidualBlock(
-            new PointProjectionFactor(obs_i, l.sightings[k].xy1.head<2>(), T_b_c_, sqrt_info),
-            makeLoss(options_),
+            newPointFactor(obs_i, l.sightings[k].xy1.head<2>()), makeLoss(options_),
             {para_pose_[0].data(), para_pose_[k].data(), inverseDepthBlock(index)}, {0, 2});
     }
     if (options_.use_lines) {
       // Lines first seen in the oldest frame leave the state with it, like points anchored
       // there: all their window observations go into the prior.
-      const double line_sqrt_info = line_scale_ * camera_.intrinsics[0] / options_.line_sigma_px;
-      std::map<int64_t, int> slot;
-      for (int i = 0; i <= frame_count_; ++i) slot[header_ns_[i]] = i;
+      const std::map<int64_t, int> slot = windowSlots();
       std::size_t k = 0;
       for (const auto& [id, l] : lines_.landmarks()) {
         if (!lines_.usable(l)) continue;
         double* line_block = lineBlock(k++);
         if (l.observations.begin()->first != header_ns_[0] || !lineSelected(l)) continue;
         for (const auto& [ns, obs] : l.observations)
-          info->addResidualBlock(
-              new LineProjectionFactor(obs.start_norm, obs.end_norm, T_b_c_, line_sqrt_info),
-              makeLoss(options_), {para_pose_[slot.at(ns)].data(), line_block}, {1});
+          info->addResidualBlock(newLineFactor(obs), makeLoss(options_),
+                                 {para_pose_[slot.at(ns)].data(), line_block}, {1});
       }
     }
     if (!info->marginalize()) {

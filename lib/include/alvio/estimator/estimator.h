@@ -30,7 +30,9 @@
 
 namespace alvio {
 
+class LineProjectionFactor;
 class MarginalizationInfo;
+class PointProjectionFactor;
 
 enum class EstimatorStatus { kInitializing, kTracking };
 
@@ -216,6 +218,11 @@ class Estimator {
   std::size_t num_point_params_ = 0;
   double* inverseDepthBlock(int index) { return &para_landmarks_[index]; }
   double* lineBlock(std::size_t k);
+  // Reprojection factors at the current weights, for the window solve and the prior alike.
+  PointProjectionFactor* newPointFactor(const Eigen::Vector2d& obs_i,
+                                        const Eigen::Vector2d& obs_j) const;
+  LineProjectionFactor* newLineFactor(const LineLandmarkObservation& obs) const;
+  std::map<int64_t, int> windowSlots() const;  ///< frame stamp -> index in the window
 
   std::shared_ptr<MarginalizationInfo> last_marginalization_;
   std::vector<double*> last_marginalization_blocks_;
