@@ -110,6 +110,17 @@ TEST(Config, LineMapFilterIsReadAndANegativeParallaxIsRejected) {
                         {"estimator.line_map_min_parallax", "must not be negative"});
 }
 
+TEST(Config, SolverIterationsAreReadAndZeroForTheFirstSolveIsRejected) {
+  const Config c = Config::load(test::sourcePath("config/euroc.yaml"));
+  EXPECT_EQ(c.estimator.max_iterations, 5);
+  EXPECT_EQ(c.estimator.init_max_iterations, 24);
+  const std::string dir = test::scratchDir();
+  const std::string path = writeFile(
+      dir, "init.yaml", eurocYamlReplacing("init_max_iterations: 24", "init_max_iterations: 0"));
+  expectErrorMentioning([&] { Config::load(path); },
+                        {"estimator.init_max_iterations", "must be at least 1"});
+}
+
 TEST(Config, NonRotationExtrinsicIsRejected) {
   const std::string dir = test::scratchDir();
   const std::string path = writeFile(dir, "rot.yaml", eurocYamlReplacing("0.0148655429818", "2.0"));

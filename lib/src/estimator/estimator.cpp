@@ -242,7 +242,7 @@ bool Estimator::addFrame(const FeatureFrame& frame, FrameTiming* timing) {
     status_ = EstimatorStatus::kTracking;
     // Initialisation ends with a first visual-inertial optimisation of the aligned window,
     // given more iterations than the per-frame ones: the linear alignment is only a start.
-    optimize(timing, 3 * options_.max_iterations);
+    optimize(timing, options_.init_max_iterations);
     // A window with too little excitation can align to a wrong gravity; the refinement then
     // pushes the error into the accelerometer bias. Reject such an initialisation and wait.
     if (Bas_[W_].norm() > options_.init_max_accel_bias || !Ps_[W_].allFinite()) {

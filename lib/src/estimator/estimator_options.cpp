@@ -13,6 +13,7 @@ EstimatorOptions EstimatorOptions::load(const YamlReader& yaml, const std::strin
   o.window_size = yaml.getInt(p + "window_size", o.window_size);
   o.keyframe_parallax_px = yaml.getDouble(p + "keyframe_parallax_px", o.keyframe_parallax_px);
   o.max_iterations = yaml.getInt(p + "max_iterations", o.max_iterations);
+  o.init_max_iterations = yaml.getInt(p + "init_max_iterations", o.init_max_iterations);
   o.num_threads = yaml.getInt(p + "num_threads", o.num_threads);
   o.point_sigma_px = yaml.getDouble(p + "point_sigma_px", o.point_sigma_px);
   o.robust_loss = yaml.getString(p + "robust_loss", o.robust_loss);
@@ -59,6 +60,8 @@ EstimatorOptions EstimatorOptions::load(const YamlReader& yaml, const std::strin
   o.max_rotation_jump_deg = yaml.getDouble(p + "max_rotation_jump_deg", o.max_rotation_jump_deg);
   if (o.window_size < 4) throw Error(yaml.where(p + "window_size") + " must be at least 4");
   if (o.max_iterations < 1) throw Error(yaml.where(p + "max_iterations") + " must be at least 1");
+  if (o.init_max_iterations < 1)
+    throw Error(yaml.where(p + "init_max_iterations") + " must be at least 1");
   if (o.init_settle_change < 0)
     throw Error(yaml.where(p + "init_settle_change") + " must not be negative");
   if (o.init_settle_max_s < 0)

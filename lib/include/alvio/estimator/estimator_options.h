@@ -14,6 +14,7 @@ struct EstimatorOptions {
   int window_size = 10;                ///< keyframes in the window (plus the newest frame)
   double keyframe_parallax_px = 10;    ///< mean parallax that makes a frame a keyframe
   int max_iterations = 5;              ///< Ceres iterations per frame (no time limit: determinism)
+  int init_max_iterations = 24;        ///< ...for the first solve after (re-)initialisation
   int num_threads = 1;                 ///< Ceres threads
   double point_sigma_px = 1.5;         ///< reprojection noise of points
   std::string robust_loss = "cauchy";  ///< cauchy | huber | none
