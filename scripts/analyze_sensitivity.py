@@ -21,8 +21,10 @@ import matplotlib
 matplotlib.use("Agg")  # no display
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+import yaml  # noqa: E402
 
-WIDTH, HEIGHT = 752, 480
+# Records written before alvio run saved image_size.yaml came from EuRoC's cam0.
+EUROC_SIZE = (752, 480)
 
 
 def read_csv(path):
@@ -41,6 +43,31 @@ def load(dirs, name):
     return {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
 
 
+def image_size(dirs):
+    """The (width, height) the feature positions of all DIRs refer to; they must agree."""
+    sizes = {}
+    for d in dirs:
+        path = os.path.join(d, "image_size.yaml")
+        if not os.path.isfile(path):
+            print(f"alvio analyze: {d} has no image_size.yaml; assuming EuRoC's "
+                  f"{EUROC_SIZE[0]}x{EUROC_SIZE[1]}", file=sys.stderr)
+            sizes[d] = EUROC_SIZE
+            continue
+        with open(path) as f:
+            doc = yaml.safe_load(f) or {}
+        try:
+            sizes[d] = (int(doc["width"]), int(doc["height"]))
+        except (KeyError, TypeError, ValueError):
+            sys.exit(f"alvio analyze: error: {path} needs integer width and height")
+        if min(sizes[d]) <= 0:
+            sys.exit(f"alvio analyze: error: {path}: width and height must be positive")
+    if len(set(sizes.values())) > 1:
+        listing = ", ".join(f"{d} {w}x{h}" for d, (w, h) in sizes.items())
+        sys.exit("alvio analyze: error: the records come from different image sizes "
+                 f"({listing}); analyse each camera on its own")
+    return next(iter(sizes.values()))
+
+
 def monomials(u, v, degree):
     """Columns u^i v^j with i + j <= degree, in a fixed order (the estimator's order)."""
     cols = []
@@ -50,13 +77,13 @@ def monomials(u, v, degree):
     return np.stack(cols, axis=1)
 
 
-def normalised(x, y):
+def normalised(x, y, size):
     # The estimator evaluates the surface at (x / width - 0.5, y / height - 0.5).
-    return x / WIDTH - 0.5, y / HEIGHT - 0.5
+    return x / size[0] - 0.5, y / size[1] - 0.5
 
 
-def fit_surface(x, y, z, degree):
-    u, v = normalised(x, y)
+def fit_surface(x, y, z, degree, size):
+    u, v = normalised(x, y, size)
     A = monomials(u, v, degree)
     coeffs, *_ = np.linalg.lstsq(A, z, rcond=None)
     pred = A @ coeffs
@@ -65,21 +92,22 @@ def fit_surface(x, y, z, degree):
     return coeffs, pred, 1.0 - ss_res / ss_tot
 
 
-def plot_surface(kind, x, y, z, coeffs, degree, level, out):
+def plot_surface(kind, x, y, z, coeffs, degree, level, size, out):
+    width, height = size
     fig, axes = plt.subplots(1, 2, figsize=(12, 4.2))
     # Raw data: mean track length per 16 px cell.
-    bins = (WIDTH // 16, HEIGHT // 16)
-    s, _, _ = np.histogram2d(x, y, bins=bins, range=[[0, WIDTH], [0, HEIGHT]], weights=z)
-    n, _, _ = np.histogram2d(x, y, bins=bins, range=[[0, WIDTH], [0, HEIGHT]])
+    bins = (max(1, width // 16), max(1, height // 16))
+    s, _, _ = np.histogram2d(x, y, bins=bins, range=[[0, width], [0, height]], weights=z)
+    n, _, _ = np.histogram2d(x, y, bins=bins, range=[[0, width], [0, height]])
     with np.errstate(invalid="ignore"):
         mean = s / n
-    im = axes[0].imshow(mean.T, origin="upper", extent=[0, WIDTH, HEIGHT, 0], cmap="viridis")
+    im = axes[0].imshow(mean.T, origin="upper", extent=[0, width, height, 0], cmap="viridis")
     axes[0].set_title(f"{kind}: mean track length (raw, {len(z)} features)")
     fig.colorbar(im, ax=axes[0], label="frames tracked in the window")
-    gx, gy = np.meshgrid(np.linspace(0, WIDTH, 188), np.linspace(0, HEIGHT, 120))
-    gu, gv = normalised(gx.ravel(), gy.ravel())
+    gx, gy = np.meshgrid(np.linspace(0, width, 188), np.linspace(0, height, 120))
+    gu, gv = normalised(gx.ravel(), gy.ravel(), size)
     surf = (monomials(gu, gv, degree) @ coeffs).reshape(gx.shape)
-    im = axes[1].imshow(surf, origin="upper", extent=[0, WIDTH, HEIGHT, 0], cmap="viridis")
+    im = axes[1].imshow(surf, origin="upper", extent=[0, width, height, 0], cmap="viridis")
     axes[1].contour(gx, gy, surf, levels=[level], colors="red", linewidths=1.5)
     axes[1].set_title(f"{kind}: fitted surface (degree {degree}); red: selection level {level:.2f}")
     fig.colorbar(im, ax=axes[1], label="expected frames tracked")
@@ -130,6 +158,7 @@ def main():
     for d in args.dirs:
         if not os.path.isfile(os.path.join(d, "windows.csv")):
             sys.exit(f"alvio analyze: error: {d} has no windows.csv (run alvio run --analysis {d})")
+    size = image_size(args.dirs)
     os.makedirs(args.out, exist_ok=True)
 
     surfaces = {}
@@ -140,11 +169,11 @@ def main():
             report.append(f"{kind}: too few records, no surface")
             continue
         x, y, z = data["x_px"], data["y_px"], data["tracked_frames"]
-        coeffs, pred, r2 = fit_surface(x, y, z, args.degree)
+        coeffs, pred, r2 = fit_surface(x, y, z, args.degree, size)
         level = float(np.quantile(pred, quantile))
         kept = float(np.mean(pred >= level))
         surfaces[kind] = (coeffs, level)
-        png = plot_surface(kind, x, y, z, coeffs, args.degree, level, args.out)
+        png = plot_surface(kind, x, y, z, coeffs, args.degree, level, size, args.out)
         report.append(f"{kind}: {len(z)} features, mean track {z.mean():.2f} frames, surface R^2 {r2:.3f}, "
                       f"level {level:.3f} (quantile {quantile}) keeps {100 * kept:.1f} % -> {png}")
 
@@ -160,7 +189,7 @@ def main():
         f.write("# Written by alvio analyze from: " + ", ".join(args.dirs) + "\n")
         f.write("# Expected track length over the image, evaluated at (x/width - 0.5, y/height - 0.5) with\n")
         f.write("# monomials u^i v^j (i + j <= degree) in order of total degree, then increasing j.\n")
-        f.write(f"width: {WIDTH}\nheight: {HEIGHT}\ndegree: {args.degree}\n")
+        f.write(f"width: {size[0]}\nheight: {size[1]}\ndegree: {args.degree}\n")
         for kind, (coeffs, level) in surfaces.items():
             f.write(f"{kind}:\n  min_expected_track: {level:.6f}\n")
             f.write("  coefficients: [" + ", ".join(f"{c:.8g}" for c in coeffs) + "]\n")

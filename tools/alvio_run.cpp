@@ -90,7 +90,8 @@ int main(int argc, char** argv) {
     }
     std::unique_ptr<AnalysisWriter> analysis;
     if (args.isSet("analysis")) {
-      analysis = std::make_unique<AnalysisWriter>(args.get("analysis"));
+      analysis = std::make_unique<AnalysisWriter>(args.get("analysis"), config.camera.width,
+                                                  config.camera.height);
       options.observers.push_back(analysis.get());
     }
     std::unique_ptr<MapObserver> map;

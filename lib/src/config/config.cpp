@@ -1,12 +1,32 @@
 #include "alvio/config/config.h"
 
 #include <cstdlib>
+#include <sstream>
 
+#include "alvio/common/error.h"
 #include "alvio/common/resource_path.h"
 #include "alvio/config/yaml_overlay.h"
 #include "alvio/config/yaml_reader.h"
 
 namespace alvio {
+
+namespace {
+// A surface is a polynomial over positions normalised by the image size it was fitted on:
+// applied to another camera it would select features by nonsense.
+void checkSurfacesFitCamera(const Config& c, const YamlReader& yaml) {
+  const FeatureSelectionOptions& s = c.estimator.selection;
+  for (const TrackSurface* surface : {&s.point_surface, &s.line_surface}) {
+    if (!surface->valid()) continue;
+    if (surface->width == c.camera.width && surface->height == c.camera.height) continue;
+    std::ostringstream os;
+    os << yaml.where("estimator.selection.surfaces_file") << ": '" << s.surfaces_file
+       << "' was fitted on " << surface->width << "x" << surface->height
+       << " images, but camera.resolution is [" << c.camera.width << ", " << c.camera.height
+       << "]: run alvio analyze on records of this camera";
+    throw Error(os.str());
+  }
+}
+}  // namespace
 
 Config Config::load(const std::string& path) {
   return load(YamlReader::fromString(readConfigText(path), path));
@@ -22,6 +42,7 @@ Config Config::load(const YamlReader& yaml) {
   c.estimator = EstimatorOptions::load(yaml, "estimator");
   c.lines = LineTrackerOptions::load(yaml, "lines");
   c.logger = LoggerOptions::load(yaml, "logger");
+  checkSurfacesFitCamera(c, yaml);
   yaml.markKnown("mapping");  // read by alvio_mapping (MappingOptions::load)
   yaml.warnUnknownKeys();
   return c;

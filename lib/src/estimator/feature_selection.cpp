@@ -23,6 +23,10 @@ void loadTrackSurfaces(const std::string& path, TrackSurface* points, TrackSurfa
   const int degree = yaml.getInt("degree");
   if (degree < 0 || degree > 8) throw Error(yaml.where("degree") + " must be in 0..8");
   const std::size_t n = static_cast<std::size_t>((degree + 1) * (degree + 2) / 2);
+  for (const char* key : {"width", "height"})
+    if (yaml.has(key) && yaml.getDouble(key) <= 0)
+      throw Error(yaml.where(key) +
+                  " must be positive (the image size the surfaces were fitted on)");
   for (auto [key, surface] : {std::make_pair("points", points), std::make_pair("lines", lines)}) {
     surface->coefficients.clear();
     if (!yaml.has(key)) continue;

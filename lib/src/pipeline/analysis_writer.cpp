@@ -18,8 +18,13 @@ void open(std::ofstream* f, const std::string& path, const char* header) {
 }
 }  // namespace
 
-AnalysisWriter::AnalysisWriter(const std::string& dir) : dir_(dir) {
+AnalysisWriter::AnalysisWriter(const std::string& dir, int image_width, int image_height)
+    : dir_(dir) {
   std::filesystem::create_directories(dir);
+  // The fitted surfaces are normalised by the image size, so `alvio analyze` must know it.
+  std::ofstream size_file(dir + "/image_size.yaml", std::ios::trunc);
+  size_file << "width: " << image_width << "\nheight: " << image_height << "\n";
+  if (!size_file) throw Error("cannot write '" + dir + "/image_size.yaml'");
   open(&points_, dir + "/points.csv", "window_t,id,x_px,y_px,tracked_frames");
   open(&lines_, dir + "/lines.csv", "window_t,id,x_px,y_px,tracked_frames");
   open(&windows_csv_, dir + "/windows.csv",

@@ -4,6 +4,7 @@
 //   lines.csv    same columns; x, y is the segment midpoint in the undistorted image
 //   windows.csv  window_t, frames, mean_intensity, motion_m, points, lines,
 //                mean_point_track, mean_line_track
+//   image_size.yaml  width, height of the images the positions refer to
 // `alvio analyze DIR` fits and plots them.
 
 #include <fstream>
@@ -15,8 +16,9 @@ namespace alvio {
 
 class AnalysisWriter : public RunObserver {
  public:
-  /// Creates `dir` and opens the three files; throws alvio::Error naming the path.
-  explicit AnalysisWriter(const std::string& dir);
+  /// Creates `dir`, writes image_size.yaml and opens the three CSV files; throws
+  /// alvio::Error naming the path.
+  AnalysisWriter(const std::string& dir, int image_width, int image_height);
   void onFrame(const FrameView& frame) override;
   std::string stage() const override { return "analysis"; }
   void onFinish(const RunResult& result) override;
