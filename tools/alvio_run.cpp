@@ -6,7 +6,6 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
-#include <sstream>
 
 #include "alvio/common/arg_parser.h"
 #include "alvio/common/error.h"
@@ -49,8 +48,7 @@ int main(int argc, char** argv) {
     std::string config_text = readConfigText(config_path);
     std::vector<std::string> override_keys;
     if (args.isSet("set")) {
-      std::stringstream list(args.get("set"));
-      for (std::string assignment; std::getline(list, assignment, ',');) {
+      for (const std::string& assignment : splitAssignments(args.get("set"))) {
         const std::string overlay = assignmentToYaml(assignment);
         config_text = overlayYaml(config_text, config_path, overlay, "--set " + assignment);
         const auto keys = yamlLeafKeys(overlay);

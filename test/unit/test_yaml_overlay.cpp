@@ -66,3 +66,20 @@ TEST(YamlOverlay, AssignmentsBecomeNestedOverlays) {
   EXPECT_THROW(assignmentToYaml("=3"), Error);
   EXPECT_THROW(assignmentToYaml("estimator..window_size=3"), Error);
 }
+
+TEST(YamlOverlay, AssignmentListsSplitOnlyBetweenAssignments) {
+  using List = std::vector<std::string>;
+  EXPECT_EQ(splitAssignments("a=1"), List({"a=1"}));
+  EXPECT_EQ(splitAssignments("a=1,b.c=true"), List({"a=1", "b.c=true"}));
+  // A sequence value keeps its commas, so `--set camera.resolution=[640,480]` works.
+  EXPECT_EQ(splitAssignments("camera.resolution=[640,480],a=2"),
+            List({"camera.resolution=[640,480]", "a=2"}));
+  EXPECT_EQ(splitAssignments("m={x: 1, y: [2, 3]},s='a,b',t=\"c,d\""),
+            List({"m={x: 1, y: [2, 3]}", "s='a,b'", "t=\"c,d\""}));
+  EXPECT_THROW(splitAssignments("a=[1,2"), Error);
+  EXPECT_THROW(splitAssignments("a=1]"), Error);
+  EXPECT_THROW(splitAssignments("a='x"), Error);
+  const YamlReader yaml = YamlReader::fromString(
+      assignmentToYaml(splitAssignments("camera.resolution=[640,480]").front()), "--set");
+  EXPECT_EQ(yaml.getDoubles("camera.resolution", 2), std::vector<double>({640, 480}));
+}

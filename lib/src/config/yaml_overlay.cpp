@@ -114,6 +114,34 @@ std::string readConfigText(const std::string& path) {
   return readConfigText(path, 0);
 }
 
+std::vector<std::string> splitAssignments(const std::string& list) {
+  std::vector<std::string> out;
+  std::string current;
+  int depth = 0;
+  char quote = 0;
+  for (const char c : list) {
+    if (quote) {
+      if (c == quote) quote = 0;
+    } else if (c == '"' || c == '\'') {
+      quote = c;
+    } else if (c == '[' || c == '{') {
+      ++depth;
+    } else if (c == ']' || c == '}') {
+      if (--depth < 0) break;
+    } else if (c == ',' && depth == 0) {
+      out.push_back(current);
+      current.clear();
+      continue;
+    }
+    current += c;
+  }
+  if (depth != 0 || quote)
+    throw Error("configuration overrides '" + list + "': unbalanced " +
+                (quote ? std::string("quote") : std::string("brackets")));
+  out.push_back(current);
+  return out;
+}
+
 std::string assignmentToYaml(const std::string& assignment) {
   const auto eq = assignment.find('=');
   if (eq == std::string::npos || eq == 0)

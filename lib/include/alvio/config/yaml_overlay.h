@@ -23,6 +23,12 @@ std::vector<std::string> yamlLeafKeys(const std::string& text);
 /// "estimator:\n  window_size: 8\n". Throws alvio::Error on a missing '=' or empty key.
 std::string assignmentToYaml(const std::string& assignment);
 
+/// A comma-separated list of assignments split at the commas that separate them, not at
+/// those inside a flow sequence or mapping or a quoted value:
+/// "a=1,camera.resolution=[640, 480]" -> {"a=1", "camera.resolution=[640, 480]"}.
+/// Throws alvio::Error on unbalanced brackets or quotes.
+std::vector<std::string> splitAssignments(const std::string& list);
+
 /// The contents of a text file; throws alvio::Error naming it when it cannot be read.
 std::string readTextFile(const std::string& path);
 
