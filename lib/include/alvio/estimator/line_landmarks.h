@@ -40,8 +40,8 @@ struct LineRetirementCounts {
 std::string describeLineRetirement(const LineRetirementCounts& counts, double max_rms_px,
                                    double min_parallax);
 /// Over three quarters of at least kMinTracksToJudgeTheFitLimit tracks fail the fit limit. On
-/// the whole of sim_MH_05, 392 of 1206 (33 %) do; a camera whose line endpoints are much
-/// noisier fails nearly all and needs a looser limit.
+/// the whole of sim_MH_05, 393 of 1206 (33 %) do (fourteenth session); a camera whose line
+/// endpoints are much noisier fails nearly all and needs a looser limit.
 inline constexpr int kMinTracksToJudgeTheFitLimit = 200;
 bool fitLimitLooksTooTight(const LineRetirementCounts& counts);
 /// What to tell the user when fitLimitLooksTooTight.
