@@ -8,9 +8,11 @@ at the IMU's stamps, as the simulator writes, or mav0/state_groundtruth_estimate
 The ground truth gives the true angular rate and specific force in the body frame; the
 difference to the measurement, with its slowly moving bias removed (a moving average over
 --window-s), is the noise. Integrated over an interval T, white noise of density s grows as
-s*sqrt(T), so for each T the script prints sqrt(E[err(T)^2] / T). For white noise that is
-flat; for vibration it falls with T, and the value at the estimator's time scale (the
-window's keyframe span, about 1 s) is what the estimator's noise density should be.
+s*sqrt(T), so for each T the script prints sqrt(E[err(T)^2] / T). The moving average takes
+part of the noise with the bias: white noise of density s reads s*sqrt(1 - T/W - T^2/(3 W^2))
+for a window W >= 2T, flat only where T << W (0.99 s at T = 0.05 s, 0.85 s at 0.5 s, 0.65 s at
+1 s with W = 2 s). For vibration it falls with T, and the value at the estimator's time scale
+(the window's keyframe span, about 1 s) is what the estimator's noise density should be.
 
 The ground truth's rotation must be smooth to second order (the simulator's spline fit is;
 a raw motion-capture track is not, and then only the long intervals mean anything).
@@ -108,7 +110,8 @@ def main():
             density = np.sqrt((d ** 2).mean(axis=0) / T)
             cells.append(" ".join(f"{v:.2g}" for v in density))
         print(f"| {name} | " + " | ".join(cells) + " |")
-    print("(x y z per cell; white noise of density s gives s in every column)")
+    print("(x y z per cell; white noise of density s gives s*sqrt(1 - T/W - T^2/(3 W^2)) for the "
+          "bias window W >= 2T: s at short T, 0.65 s at T = 1 s with W = 2 s)")
 
 
 if __name__ == "__main__":

@@ -1,0 +1,342 @@
+"""Tests of scripts/bench.py's summary logic: percentile(), what Run.result() makes of a run
+folder (summary.json, frame_stats.csv, timing.csv), the markdown tables, and main() end to
+end with a stand-in alvio_run that copies prepared run files (no real runs are made)."""
+import csv
+import json
+import math
+import os
+import subprocess
+import sys
+import tempfile
+import unittest
+from pathlib import Path
+
+import numpy as np
+
+SCRIPTS = Path(__file__).resolve().parents[2] / "scripts"
+sys.dont_write_bytecode = True  # keep scripts/ free of __pycache__
+sys.path.insert(0, str(SCRIPTS))
+import bench  # noqa: E402
+
+STAGES = ["preprocess", "point_tracking", "point_detection", "line_detection", "line_tracking",
+          "optimization", "marginalization"]
+
+
+def write_run_folder(folder, seed, lines=True, ate=0.1234, frames=40):
+    """A run folder as alvio_run writes it, from seeded random numbers. Returns the inputs."""
+    rng = np.random.default_rng(seed)
+    folder.mkdir(parents=True, exist_ok=True)
+    stages = [s for s in STAGES if lines or not s.startswith("line")]
+    t = 100.0 + 0.05 * np.arange(frames)
+    ms = {s: rng.uniform(0.5, 8.0, frames).round(4) for s in stages}
+    # Detection every other frame, as with detect_every = 2.
+    ms["point_detection"][1::2] = 0.0
+    if lines:
+        ms["line_detection"][::2] = 0.0
+    total = sum(ms.values())
+    with open(folder / "timing.csv", "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["t"] + [s + "_ms" for s in stages] + ["total_ms"])
+        for k in range(frames):
+            w.writerow([f"{t[k]:.9f}"] + [f"{ms[s][k]:.4f}" for s in stages] + [f"{total[k]:.4f}"])
+    # frame_stats: frames before initialisation use no features and must not count.
+    points_used = rng.integers(20, 150, frames)
+    lines_used = rng.integers(0, 40, frames) if lines else np.zeros(frames, int)
+    points_used[:5] = 0
+    lines_used[:5] = 0
+    with open(folder / "frame_stats.csv", "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["t", "points", "lines", "points_used", "lines_used", "w_p", "w_l", "alpha"])
+        for k in range(frames):
+            w.writerow([f"{t[k]:.6f}", 200, 50, points_used[k], lines_used[k], 0.5, 0.5, 1.0])
+    timing = {s: {"median": float(np.median(ms[s])), "p95": float(np.percentile(ms[s], 95))}
+              for s in stages}
+    timing["total"] = {"median": float(np.median(total)), "p95": float(np.percentile(total, 95))}
+    summary = {"frames": frames, "poses": frames - 5, "resets": seed % 3, "ate_rmse_m": ate,
+               "initialization": {"time": 100.25, "scale_error": 0.0321,
+                                  "gravity_error_deg": 0.456},
+               "timing_ms": timing}
+    (folder / "summary.json").write_text(json.dumps(summary))
+    return {"t": t, "ms": ms, "total": total, "points_used": points_used,
+            "lines_used": lines_used, "summary": summary}
+
+
+def table_rows(text):
+    """Markdown table rows (header and separator excluded) as lists of cells."""
+    rows = [line for line in text.splitlines() if line.startswith("|")][2:]
+    return [[c.strip() for c in row.strip().strip("|").split("|")] for row in rows]
+
+
+class PercentileTest(unittest.TestCase):
+    def test_known_values(self):
+        # Linear interpolation between closest ranks, as numpy's default.
+        self.assertEqual(bench.percentile([1, 2, 3, 4], 50), 2.5)
+        self.assertAlmostEqual(bench.percentile([10, 20, 30, 40, 50], 95), 48.0)
+        self.assertAlmostEqual(bench.percentile([10, 20, 30, 40, 50], 25), 20.0)
+        self.assertEqual(bench.percentile([10, 20, 30, 40, 50], 0), 10)
+        self.assertEqual(bench.percentile([10, 20, 30, 40, 50], 100), 50)
+        self.assertEqual(bench.percentile([7.5], 95), 7.5)
+
+    def test_empty_is_nan(self):
+        self.assertTrue(math.isnan(bench.percentile([], 50)))
+
+    def test_matches_numpy_on_random_lists(self):
+        rng = np.random.default_rng(3)
+        for n in (2, 3, 10, 101, 1000):
+            v = sorted(rng.exponential(5.0, n))
+            for q in (5, 50, 90, 95, 99):
+                self.assertAlmostEqual(bench.percentile(v, q), float(np.percentile(v, q)), places=9)
+
+
+class RunResultTest(unittest.TestCase):
+    def setUp(self):
+        self.tmp = tempfile.TemporaryDirectory()
+        self.dir = Path(self.tmp.name)
+
+    def tearDown(self):
+        self.tmp.cleanup()
+
+    def result(self, out, wall_s=0.5, rc=0):
+        run = bench.Run("sim_X", self.dir, "lines", [], out, "alvio_run", -1)
+        # What reap() sets once the process has ended.
+        run.rc, run.wall_s, run.cpu_s, run.rss_mb = rc, wall_s, 0.4, 123.0
+        return run.result()
+
+    def test_summary_fields(self):
+        d = write_run_folder(self.dir / "run", seed=4, ate=0.0567)
+        r = self.result(self.dir / "run")
+        self.assertEqual(r["ate"], 0.0567)
+        self.assertEqual(r["resets"], 1)
+        self.assertEqual(r["frames"], 40)
+        self.assertEqual(r["poses"], 35)
+        self.assertEqual(r["init"]["scale_error"], 0.0321)
+        self.assertEqual(r["timing"], d["summary"]["timing_ms"])
+        self.assertEqual((r["rc"], r["wall_s"], r["peak_rss_mb"]), (0, 0.5, 123.0))
+
+    def test_features_used_exclude_frames_without_optimisation(self):
+        d = write_run_folder(self.dir / "run", seed=5)
+        r = self.result(self.dir / "run")
+        used = (d["points_used"] > 0) | (d["lines_used"] > 0)
+        self.assertAlmostEqual(r["points_used"], d["points_used"][used].mean())
+        self.assertAlmostEqual(r["lines_used"], d["lines_used"][used].mean())
+        # The five leading zero rows would pull the mean down if counted.
+        self.assertGreater(r["points_used"], d["points_used"].mean())
+
+    def test_timing_figures(self):
+        d = write_run_folder(self.dir / "run", seed=6)
+        r = self.result(self.dir / "run")
+        ms = d["ms"]
+        self.assertAlmostEqual(r["duration_s"], d["t"][-1] - d["t"][0])
+        opt = ms["optimization"] + ms["marginalization"]
+        self.assertAlmostEqual(r["opt_total_median"], np.median(opt), places=9)
+        self.assertAlmostEqual(r["opt_total_p95"], np.percentile(opt, 95), places=9)
+        pts = ms["preprocess"] + ms["point_tracking"] + ms["point_detection"]
+        lns = ms["line_detection"] + ms["line_tracking"]
+        self.assertAlmostEqual(r["points_front_end_median"], np.median(pts), places=9)
+        self.assertAlmostEqual(r["points_front_end_mean"], pts.mean(), places=9)
+        self.assertAlmostEqual(r["lines_front_end_median"], np.median(lns), places=9)
+        self.assertAlmostEqual(r["lines_front_end_mean"], lns.mean(), places=9)
+        # Guard: the data tell a median of per-frame sums from a sum of medians.
+        sum_of_medians = sum(np.median(ms[s]) for s in ("line_detection", "line_tracking"))
+        self.assertGreater(abs(sum_of_medians - np.median(lns)), 0.1)
+
+    def test_points_only_run_has_no_lines_front_end(self):
+        write_run_folder(self.dir / "run", seed=7, lines=False)
+        r = self.result(self.dir / "run")
+        self.assertIn("points_front_end_median", r)
+        self.assertNotIn("lines_front_end_median", r)
+        self.assertEqual(r["lines_used"], 0)
+
+    def test_failed_run_without_files(self):
+        (self.dir / "run").mkdir()
+        r = self.result(self.dir / "run", rc=134)
+        self.assertEqual(r["rc"], 134)
+        for key in ("ate", "timing", "duration_s", "opt_total_median", "points_used"):
+            self.assertNotIn(key, r)
+
+
+class TablesTest(unittest.TestCase):
+    def test_bench_table_row(self):
+        r = {"sequence": "sim_MH_01", "variant": "lines", "rc": 0, "wall_s": 8.0,
+             "peak_rss_mb": 211.6, "ate": 0.04321, "resets": 2,
+             "init": {"scale_error": 0.0123, "gravity_error_deg": 0.347},
+             "timing": {"total": {"median": 12.34, "p95": 20.06}},
+             "points_front_end_median": 4.44, "points_front_end_mean": 5.06,
+             "lines_front_end_median": 7.71, "lines_front_end_mean": 8.29,
+             "opt_total_median": 3.96, "duration_s": 20.0}
+        (row,) = table_rows(bench.bench_table([r]))
+        self.assertEqual(row, ["sim_MH_01", "lines", "0.0432", "2", "1.2", "0.35", "12.3 / 20.1",
+                               "4.4 / 5.1", "7.7 / 8.3", "4.0", "2.50", "212"])
+
+    def test_bench_table_missing_values(self):
+        # A run that failed before writing anything: every figure is a dash.
+        r = {"sequence": "sim_MH_05", "variant": "points", "rc": 1, "wall_s": 1.0,
+             "peak_rss_mb": None}
+        (row,) = table_rows(bench.bench_table([r]))
+        self.assertEqual(row[:2], ["sim_MH_05", "points"])
+        self.assertEqual(row[2:6], ["–"] * 4)
+        self.assertEqual(row[6:], ["– / –", "– / –", "–", "–", "–", "–"])
+
+    def test_compare_table_ratios_b_over_a(self):
+        results = [
+            {"sequence": "s1", "variant": "a", "ate": 0.2, "opt_total_median": 4.0,
+             "peak_rss_mb": 100.0, "timing": {"total": {"median": 10.0}}},
+            {"sequence": "s1", "variant": "b", "ate": 0.1, "opt_total_median": 5.0,
+             "peak_rss_mb": 150.0, "timing": {"total": {"median": 12.5}}},
+            {"sequence": "s2", "variant": "a", "ate": 0.3},  # b did not run
+        ]
+        rows = table_rows(bench.compare_table(results, "a", "b"))
+        self.assertEqual(rows[0], ["s1", "0.2000", "0.1000", "0.500", "1.250", "1.250", "1.500"])
+        self.assertEqual(rows[1], ["s2", "0.3000", "–", "–", "–", "–", "–"])
+
+    def test_ablation_table_against_reference(self):
+        def res(v, ate, opt, pts, lns):
+            return {"sequence": "sim_MH_05", "variant": v, "ate": ate, "opt_total_median": opt,
+                    "points_used": pts, "lines_used": lns}
+        results = [res("sel-none", 0.100, 8.0, 120.0, 30.0),
+                   res("sel-lines", 0.110, 6.0, 120.0, 18.0),
+                   res("sel-points", 0.095, 4.0, 60.0, 30.0),
+                   res("sel-both", 0.125, 2.0, 60.0, 18.0),
+                   res("sel-none", 9.9, 99.0, 1.0, 1.0) | {"sequence": "other"}]
+        text = bench.ablation_table(results, "sim_MH_05")
+        self.assertTrue(text.startswith("**sim_MH_05**"))
+        rows = table_rows(text)
+        self.assertEqual([r[0] for r in rows], [label for label, _ in bench.ABLATION])
+        self.assertEqual(rows[0], ["no selection", "120.0", "30.0", "8.00", "reference", "0.1000",
+                                   "reference"])
+        self.assertEqual(rows[1][3:], ["6.00", "-25.0 %", "0.1100", "+10.0 %"])
+        self.assertEqual(rows[2][3:], ["4.00", "-50.0 %", "0.0950", "-5.0 %"])
+        self.assertEqual(rows[3][3:], ["2.00", "-75.0 %", "0.1250", "+25.0 %"])
+
+    def test_parse_variant(self):
+        self.assertEqual(bench.parse_variant("points"), ("points", ["--no-lines"]))
+        self.assertEqual(bench.parse_variant("fast=--set estimator.max_iterations=4"),
+                         ("fast", ["--set", "estimator.max_iterations=4"]))
+        with self.assertRaises(SystemExit) as cm:
+            bench.parse_variant("nonsense")
+        self.assertIn("unknown variant 'nonsense'", str(cm.exception.code))
+
+
+FAKE_RUN = """#!/usr/bin/python3
+# Stand-in for alvio_run: records its arguments and copies the prepared run files.
+import json, shutil, sys
+from pathlib import Path
+argv = sys.argv[1:]
+out = Path(argv[argv.index("--out") + 1])
+seq = Path(argv[argv.index("--dataset") + 1]).name
+variant = "points" if "--no-lines" in argv else "lines"
+(out / "argv.json").write_text(json.dumps(argv))
+print(f"fake alvio_run: {seq} {variant}")
+src = Path(__file__).parent / "fixtures" / seq / variant
+for f in src.iterdir():
+    shutil.copy(f, out / f.name)
+sys.exit(int((src / "rc").read_text()) if (src / "rc").exists() else 0)
+"""
+
+
+class MainTest(unittest.TestCase):
+    """bench.py as ./alvio bench runs it, with --bin pointing at FAKE_RUN."""
+
+    def setUp(self):
+        self.tmp = tempfile.TemporaryDirectory()
+        self.dir = Path(self.tmp.name)
+        self.data = self.dir / "data"
+        self.fake = self.dir / "fake" / "alvio_run"
+        self.fake.parent.mkdir()
+        self.fake.write_text(FAKE_RUN)
+        self.fake.chmod(0o755)
+        self.inputs = {}
+        for k, seq in enumerate(["sim_A", "sim_B_realimu"]):
+            (self.data / seq / "mav0").mkdir(parents=True)
+            for j, variant in enumerate(["points", "lines"]):
+                self.inputs[seq, variant] = write_run_folder(
+                    self.fake.parent / "fixtures" / seq / variant, seed=10 + 2 * k + j,
+                    lines=variant == "lines", ate=0.05 + 0.01 * (2 * k + j))
+
+    def tearDown(self):
+        self.tmp.cleanup()
+
+    def bench(self, *args):
+        env = dict(os.environ, PYTHONDONTWRITEBYTECODE="1")
+        return subprocess.run(["/usr/bin/python3", str(SCRIPTS / "bench.py"),
+                               "--data", str(self.data), "--out", str(self.dir / "out"),
+                               "--bin", str(self.fake), *args],
+                              capture_output=True, text=True, env=env, timeout=60)
+
+    def test_runs_and_tables(self):
+        p = self.bench("--sequences", "sim_A,sim_B_realimu", "--variants", "points,lines")
+        self.assertEqual(p.returncode, 0, p.stderr)
+        out = self.dir / "out"
+        results = json.loads((out / "results.json").read_text())
+        # Variants interleaved per sequence.
+        self.assertEqual([(r["sequence"], r["variant"]) for r in results],
+                         [("sim_A", "points"), ("sim_A", "lines"),
+                          ("sim_B_realimu", "points"), ("sim_B_realimu", "lines")])
+        for r in results:
+            argv = json.loads((out / r["sequence"] / r["variant"] / "argv.json").read_text())
+            self.assertEqual(argv[argv.index("--dataset") + 1], str(self.data / r["sequence"]))
+            self.assertEqual(argv[argv.index("--out") + 1], str(out / r["sequence"] / r["variant"]))
+            self.assertIn("--quiet", argv)
+            self.assertEqual("--no-lines" in argv, r["variant"] == "points")
+            # The real EuRoC IMU runs with the in-flight noise configuration.
+            config = Path(argv[argv.index("--config") + 1]).name
+            self.assertEqual(config, "euroc_real.yaml" if r["sequence"] == "sim_B_realimu"
+                             else "euroc.yaml")
+            # The program's output goes to the run's log.
+            log = (out / r["sequence"] / r["variant"] / "run.log").read_text()
+            self.assertIn(f"fake alvio_run: {r['sequence']} {r['variant']}", log)
+
+        md = (out / "results.md").read_text()
+        self.assertEqual(p.stdout, md)
+        self.assertIn("config/euroc_real.yaml", md)  # the real-IMU note
+        rows = table_rows(md)
+        self.assertEqual(len(rows), 4)
+        for row, r in zip(rows, results):
+            d = self.inputs[r["sequence"], r["variant"]]
+            ms = d["ms"]
+            pts = ms["preprocess"] + ms["point_tracking"] + ms["point_detection"]
+            self.assertEqual(row[:2], [r["sequence"], r["variant"]])
+            self.assertEqual(row[2], f"{d['summary']['ate_rmse_m']:.4f}")
+            self.assertEqual(row[4], "3.2")  # 100 * scale_error
+            total = d["total"]
+            self.assertEqual(row[6], f"{np.median(total):.1f} / {np.percentile(total, 95):.1f}")
+            self.assertEqual(row[7], f"{np.median(pts):.1f} / {pts.mean():.1f}")
+            if r["variant"] == "points":
+                self.assertEqual(row[8], "–")
+            else:
+                lns = ms["line_detection"] + ms["line_tracking"]
+                self.assertEqual(row[8], f"{np.median(lns):.1f} / {lns.mean():.1f}")
+            opt = ms["optimization"] + ms["marginalization"]
+            self.assertEqual(row[9], f"{np.median(opt):.1f}")
+            # Real-time factor: sequence time over the run's wall time.
+            duration = d["t"][-1] - d["t"][0]
+            self.assertGreater(r["wall_s"], 0)
+            self.assertEqual(row[10], f"{duration / r['wall_s']:.2f}")
+
+    def test_failed_run_gives_exit_1(self):
+        (self.fake.parent / "fixtures" / "sim_A" / "lines" / "rc").write_text("3")
+        p = self.bench("--sequences", "sim_A", "--variants", "points,lines")
+        self.assertEqual(p.returncode, 1)
+        results = json.loads((self.dir / "out" / "results.json").read_text())
+        self.assertEqual([r["rc"] for r in results], [0, 3])
+
+    def test_compare_appends_ratio_table(self):
+        p = self.bench("--sequences", "sim_A", "--compare", "points", "lines")
+        self.assertEqual(p.returncode, 0, p.stderr)
+        tables = p.stdout.split("\n\n")
+        self.assertEqual(len(tables), 2)
+        (row,) = table_rows(tables[1])
+        ate_points = self.inputs["sim_A", "points"]["summary"]["ate_rmse_m"]
+        ate_lines = self.inputs["sim_A", "lines"]["summary"]["ate_rmse_m"]
+        self.assertEqual(row[:4], ["sim_A", f"{ate_points:.4f}", f"{ate_lines:.4f}",
+                                   f"{ate_lines / ate_points:.3f}"])
+
+    def test_missing_sequence_names_it(self):
+        p = self.bench("--sequences", "sim_nowhere")
+        self.assertNotEqual(p.returncode, 0)
+        self.assertIn(str(self.data / "sim_nowhere"), p.stderr)
+        self.assertFalse((self.dir / "out" / "results.json").exists())
+
+
+if __name__ == "__main__":
+    unittest.main()
