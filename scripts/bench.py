@@ -5,11 +5,18 @@ and print markdown tables of accuracy, per-stage time, real-time factor and peak
   ./alvio bench [--sequences sim_MH_01,sim_MH_05] [--variants points,lines] [--out DIR]
   ./alvio bench --compare lines "fast=--set estimator.max_iterations=4"
   ./alvio ablation --dataset sim_MH_05
+  ./alvio bench --compare it8 it5 --repeats 3   # each run 3x, a noise setting nudged by 0.07 %
 
 A variant is a name from VARIANTS or "name=<alvio run arguments>"; "--bin PATH" among the
 arguments runs another build's alvio_run (to compare builds). Runs are single-threaded and
 deterministic; --jobs runs several at once (times are then measured under load: compare
 variants only within one invocation, where they are interleaved).
+
+One run per sequence and variant cannot tell a small change from chance: nudging a noise
+setting by 0.07 % has moved single-run ATE by up to 15 %. --repeats N runs each N times, the
+k-th with --perturb's key (estimator.point_sigma_px) scaled by 1, 1 + s, 1 - s, 1 + 2s, ...
+(s = --perturb-step, 7e-4), and the tables give the mean ATE with its range and the median
+of the per-run times.
 """
 import argparse
 import csv
@@ -22,6 +29,8 @@ import subprocess
 import sys
 import time
 from pathlib import Path
+
+import yaml
 
 ROOT = Path(__file__).resolve().parent.parent
 SURFACES = ROOT / "config" / "selection_surfaces.yaml"
@@ -63,8 +72,8 @@ def parse_variant(spec):
 
 
 class Run:
-    def __init__(self, seq, data, variant, args, out, binary, max_frames):
-        self.seq, self.variant, self.out = seq, variant, out
+    def __init__(self, seq, data, variant, args, out, binary, max_frames, repeat=0):
+        self.seq, self.variant, self.out, self.repeat = seq, variant, out, repeat
         argv = [x.replace("{out}", str(out)) for x in args]  # "{out}": this run's folder
         if "--bin" in argv:
             i = argv.index("--bin")
@@ -97,7 +106,7 @@ class Run:
         self.log.close()
 
     def result(self):
-        r = {"sequence": self.seq, "variant": self.variant, "rc": self.rc,
+        r = {"sequence": self.seq, "variant": self.variant, "repeat": self.repeat, "rc": self.rc,
              "wall_s": self.wall_s, "cpu_s": self.cpu_s, "peak_rss_mb": self.rss_mb}
         summary = self.out / "summary.json"
         if summary.exists():
@@ -150,6 +159,77 @@ def percentile(values, q):
     return values[lo] + (values[hi] - values[lo]) * (k - lo)
 
 
+def config_value(path, key, depth=0):
+    """A dotted key's value in a configuration file, following its `base:` chain."""
+    if depth > 8:
+        sys.exit(f"alvio bench: error: {path}: too many nested base: files")
+    with open(path) as f:
+        doc = yaml.safe_load(f) or {}
+    node = doc
+    for part in key.split("."):
+        if not isinstance(node, dict) or part not in node:
+            node = None
+            break
+        node = node[part]
+    if node is not None:
+        return node
+    if "base" in doc:
+        return config_value(Path(path).parent / doc["base"], key, depth + 1)
+    sys.exit(f"alvio bench: error: --perturb key '{key}' is not in {path}")
+
+
+def perturbed_args(args, key, step, repeat):
+    """The run's arguments with `key` scaled for the repeat-th run (none for the first)."""
+    if repeat == 0:
+        return args
+    base = None
+    for i, a in enumerate(args[:-1]):  # the variant's own --set of the key wins over the file
+        if a == "--set":
+            for assignment in args[i + 1].split(","):
+                if assignment.startswith(key + "="):
+                    base = assignment.split("=", 1)[1]
+    if base is None:
+        base = config_value(args[args.index("--config") + 1], key)
+    try:
+        base = float(base)
+    except (TypeError, ValueError):
+        sys.exit(f"alvio bench: error: --perturb key '{key}' is '{base}', not a number")
+    factor = 1 + step * ((repeat + 1) // 2) * (1 if repeat % 2 else -1)
+    return args + ["--set", f"{key}={base * factor:.9g}"]
+
+
+def aggregate(results):
+    """One result per sequence and variant: the mean ATE (with its range over the repeats)
+    and the median of every per-run figure."""
+    groups = {}
+    for r in results:
+        groups.setdefault((r["sequence"], r["variant"]), []).append(r)
+    out = []
+    for runs in groups.values():
+        if len(runs) == 1:
+            out.append(runs[0])
+            continue
+        a = dict(runs[0])
+        a["repeats"] = len(runs)
+        a["rc"] = next((r["rc"] for r in runs if r["rc"] != 0), 0)
+        ates = [r["ate"] for r in runs if r.get("ate") is not None]
+        a["ate"] = statistics.mean(ates) if len(ates) == len(runs) else None
+        a["ate_min"], a["ate_max"] = (min(ates), max(ates)) if ates else (None, None)
+        a["resets"] = max((r.get("resets") or 0) for r in runs)
+        for k, v in runs[0].items():
+            if k in ("ate", "resets", "repeat", "rc") or not isinstance(v, (int, float)):
+                continue
+            vals = [r[k] for r in runs if isinstance(r.get(k), (int, float))]
+            a[k] = statistics.median(vals) if len(vals) == len(runs) else None
+        if all(r.get("timing") for r in runs):
+            a["timing"] = {st: {q: statistics.median(r["timing"][st][q] for r in runs)
+                                for q in runs[0]["timing"][st]}
+                           for st in runs[0]["timing"]
+                           if all(st in r["timing"] for r in runs)}
+        out.append(a)
+    return out
+
+
 def run_all(runs, jobs):
     """Start runs in order (interleaved by the caller), at most `jobs` at a time."""
     pending = list(runs)
@@ -181,6 +261,12 @@ def stage(res, name, key="median"):
     return t.get(name, {}).get(key)
 
 
+def ate_cell(r):
+    if r.get("repeats") and r.get("ate_min") is not None:
+        return f"{fmt(r.get('ate'), '.4f')} ({r['ate_min']:.4f}–{r['ate_max']:.4f})"
+    return fmt(r.get("ate"), ".4f")
+
+
 def bench_table(results):
     lines = ["| sequence | variant | ATE (m) | resets | init scale err (%) | init gravity err (°) "
              "| total ms median / p95 | points front end ms median / mean "
@@ -194,7 +280,7 @@ def bench_table(results):
                f"{fmt(r['lines_front_end_median'], '.1f')} / {fmt(r['lines_front_end_mean'], '.1f')}")
         rtf = r["duration_s"] / r["wall_s"] if r.get("duration_s") and r.get("wall_s") else None
         lines.append(
-            f"| {r['sequence']} | {r['variant']} | {fmt(r.get('ate'), '.4f')} | {fmt(r.get('resets'), 'd')} "
+            f"| {r['sequence']} | {r['variant']} | {ate_cell(r)} | {fmt(r.get('resets'), 'd')} "
             f"| {fmt(100 * init['scale_error'] if 'scale_error' in init else None, '.1f')} "
             f"| {fmt(init.get('gravity_error_deg'), '.2f')} "
             f"| {fmt(stage(r, 'total'), '.1f')} / {fmt(stage(r, 'total', 'p95'), '.1f')} "
@@ -214,7 +300,7 @@ def compare_table(results, a, b):
     for seq in dict.fromkeys(r["sequence"] for r in results):
         ra, rb = by.get((seq, a), {}), by.get((seq, b), {})
         lines.append(
-            f"| {seq} | {fmt(ra.get('ate'), '.4f')} | {fmt(rb.get('ate'), '.4f')} "
+            f"| {seq} | {ate_cell(ra)} | {ate_cell(rb)} "
             f"| {fmt(ratio(ra.get('ate'), rb.get('ate')), '.3f')} "
             f"| {fmt(ratio(stage(ra, 'total'), stage(rb, 'total')), '.3f')} "
             f"| {fmt(ratio(ra.get('opt_total_median'), rb.get('opt_total_median')), '.3f')} "
@@ -237,7 +323,7 @@ def ablation_table(results, seq):
             f"| {label} | {fmt(r.get('points_used'), '.1f')} | {fmt(r.get('lines_used'), '.1f')} "
             f"| {fmt(r.get('opt_total_median'), '.2f')} "
             f"| {'reference' if v == 'sel-none' else fmt(None if dt is None else 100 * (dt - 1), '+.1f') + ' %'} "
-            f"| {fmt(r.get('ate'), '.4f')} "
+            f"| {ate_cell(r)} "
             f"| {'reference' if v == 'sel-none' else fmt(None if da is None else 100 * (da - 1), '+.1f') + ' %'} |")
     return "\n".join(lines)
 
@@ -254,12 +340,20 @@ def main():
     ap.add_argument("--out", default=str(ROOT / "out" / "bench"), help="run folders and tables [%(default)s]")
     ap.add_argument("--jobs", type=int, default=1, help="runs at once [%(default)s]")
     ap.add_argument("--max-frames", type=int, default=-1, help="stop each run after this many images")
+    ap.add_argument("--repeats", type=int, default=1,
+                    help="runs per sequence and variant, each with --perturb's key nudged [%(default)s]")
+    ap.add_argument("--perturb", default="estimator.point_sigma_px",
+                    help="the configuration key --repeats scales [%(default)s]")
+    ap.add_argument("--perturb-step", type=float, default=7e-4,
+                    help="relative step of that scaling [%(default)s]")
     ap.add_argument("--bin", default=os.environ.get("ALVIO_RUN", str(ROOT / "build/devel/lib/alvio/alvio_run")))
     ap.add_argument("--freeze", action="store_true",
                     help="copy the build's programs and libraries into OUT/bin first, so a rebuild "
                     "during the runs cannot break them")
     ap.add_argument("--render", action="store_true", help="render missing sequences first (alvio sim --benchmark)")
     a = ap.parse_args()
+    if a.repeats < 1:
+        sys.exit("alvio bench: error: --repeats must be at least 1")
 
     if a.ablation:
         variants = [v for _, v in ABLATION]
@@ -311,14 +405,19 @@ def main():
         return args + ["--config", str(config_dir / ("euroc_real.yaml" if is_real_imu(name)
                                                      else "euroc.yaml"))]
 
-    # Interleave variants per sequence so that load drifts hit all of them alike.
-    runs = [Run(name, d, v, with_config(name, args), out / name / v, a.bin, a.max_frames)
-            for name, d in datasets for v, args in parsed]
-    log(f"{len(runs)} runs ({len(datasets)} sequences x {len(parsed)} variants), {a.jobs} at a time, "
-        f"into {out}")
+    def folder(name, v, k):
+        return out / name / v if a.repeats == 1 else out / name / v / f"r{k}"
+
+    # Interleave variants per sequence (and repeat) so that load drifts hit all of them alike.
+    runs = [Run(name, d, v, perturbed_args(with_config(name, args), a.perturb, a.perturb_step, k),
+                folder(name, v, k), a.bin, a.max_frames, k)
+            for name, d in datasets for k in range(a.repeats) for v, args in parsed]
+    log(f"{len(runs)} runs ({len(datasets)} sequences x {len(parsed)} variants"
+        f"{f' x {a.repeats} repeats' if a.repeats > 1 else ''}), {a.jobs} at a time, into {out}")
     run_all(runs, a.jobs)
-    results = [r.result() for r in runs]
-    (out / "results.json").write_text(json.dumps(results, indent=2))
+    per_run = [r.result() for r in runs]
+    (out / "results.json").write_text(json.dumps(per_run, indent=2))
+    results = aggregate(per_run)
 
     if a.ablation:
         text = "\n\n".join(ablation_table(results, name) for name, _ in datasets)
@@ -326,6 +425,9 @@ def main():
         text = bench_table(results)
         if a.compare:
             text += "\n\n" + compare_table(results, parsed[0][0], parsed[1][0])
+    if a.repeats > 1:
+        text += (f"\n\nEach row: {a.repeats} runs with {a.perturb} scaled by 1, 1 ± {a.perturb_step:g}, "
+                 "...; ATE is their mean (range), times and memory their median.")
     if any(is_real_imu(name) for name, _ in datasets):
         text += ("\n\nSequences with the real EuRoC IMU (`*_realimu`) run with "
                  "config/euroc_real.yaml (in-flight IMU noise), the others with config/euroc.yaml.")

@@ -230,8 +230,66 @@ print(f"fake alvio_run: {seq} {variant}")
 src = Path(__file__).parent / "fixtures" / seq / variant
 for f in src.iterdir():
     shutil.copy(f, out / f.name)
+# A nudged noise setting (--repeats) changes the result: ATE scales with it here.
+for a in [argv[i + 1] for i, x in enumerate(argv) if x == "--set"]:
+    for kv in a.split(","):
+        if kv.startswith("estimator.point_sigma_px="):
+            summary = json.loads((out / "summary.json").read_text())
+            summary["ate_rmse_m"] *= float(kv.split("=")[1]) / 1.5
+            (out / "summary.json").write_text(json.dumps(summary))
 sys.exit(int((src / "rc").read_text()) if (src / "rc").exists() else 0)
 """
+
+
+class RepeatsTest(unittest.TestCase):
+    def setUp(self):
+        self.tmp = tempfile.TemporaryDirectory()
+        self.dir = Path(self.tmp.name)
+
+    def tearDown(self):
+        self.tmp.cleanup()
+
+    def test_perturbation_steps_alternate_around_the_configured_value(self):
+        (self.dir / "base.yaml").write_text("estimator:\n  point_sigma_px: 2.0\n  window_size: 10\n")
+        (self.dir / "real.yaml").write_text("base: base.yaml\nestimator:\n  window_size: 8\n")
+        args = ["--no-lines", "--config", str(self.dir / "real.yaml")]
+        key = "estimator.point_sigma_px"
+        self.assertEqual(bench.perturbed_args(args, key, 1e-3, 0), args)
+        # The value comes through real.yaml's base: chain.
+        values = [float(bench.perturbed_args(args, key, 1e-3, k)[-1].split("=")[1])
+                  for k in range(1, 5)]
+        for v, want in zip(values, [2.002, 1.998, 2.004, 1.996]):
+            self.assertAlmostEqual(v, want, places=9)
+        self.assertEqual(bench.perturbed_args(args, key, 1e-3, 1)[-2], "--set")
+        # A variant that sets the key itself is nudged around its own value.
+        own = ["--set", "a.b=1," + key + "=3.0", "--config", str(self.dir / "real.yaml")]
+        self.assertEqual(bench.perturbed_args(own, key, 1e-3, 2)[-1], key + "=2.997")
+        with self.assertRaises(SystemExit) as cm:
+            bench.perturbed_args(args, "estimator.nowhere", 1e-3, 1)
+        self.assertIn("estimator.nowhere", str(cm.exception.code))
+
+    def test_aggregate_means_ate_and_takes_median_times(self):
+        runs = [{"sequence": "s", "variant": "v", "repeat": k, "rc": 0, "ate": ate, "resets": rs,
+                 "wall_s": w, "peak_rss_mb": 100.0 + k, "init": {"scale_error": 0.01},
+                 "timing": {"total": {"median": t, "p95": 2 * t}}}
+                for k, (ate, rs, w, t) in enumerate([(0.10, 0, 9.0, 20.0), (0.13, 1, 5.0, 22.0),
+                                                     (0.07, 0, 7.0, 30.0)])]
+        other = dict(runs[0], variant="w")
+        (a, b) = bench.aggregate(runs + [other])
+        self.assertEqual(a["repeats"], 3)
+        self.assertAlmostEqual(a["ate"], 0.10)
+        self.assertEqual((a["ate_min"], a["ate_max"]), (0.07, 0.13))
+        self.assertEqual(a["resets"], 1)
+        self.assertEqual((a["wall_s"], a["peak_rss_mb"]), (7.0, 101.0))
+        self.assertEqual(a["timing"]["total"], {"median": 22.0, "p95": 44.0})
+        self.assertIs(b, other)  # a single run stays as it is
+        self.assertEqual(bench.ate_cell(a), "0.1000 (0.0700–0.1300)")
+        self.assertEqual(bench.ate_cell(b), "0.1000")
+        # A repeat without an ATE (a failed run) leaves no mean, and its exit code shows.
+        runs[1] = dict(runs[1], ate=None, rc=3)
+        (a,) = bench.aggregate(runs)
+        self.assertIsNone(a["ate"])
+        self.assertEqual(a["rc"], 3)
 
 
 class MainTest(unittest.TestCase):
@@ -330,6 +388,33 @@ class MainTest(unittest.TestCase):
         ate_lines = self.inputs["sim_A", "lines"]["summary"]["ate_rmse_m"]
         self.assertEqual(row[:4], ["sim_A", f"{ate_points:.4f}", f"{ate_lines:.4f}",
                                    f"{ate_lines / ate_points:.3f}"])
+
+    def test_repeats_nudge_the_noise_setting_and_average(self):
+        p = self.bench("--sequences", "sim_A", "--variants", "points,lines", "--repeats", "3")
+        self.assertEqual(p.returncode, 0, p.stderr)
+        out = self.dir / "out"
+        results = json.loads((out / "results.json").read_text())
+        # Every repeat of every variant ran, interleaved, each in a folder of its own.
+        self.assertEqual([(r["variant"], r["repeat"]) for r in results],
+                         [("points", 0), ("lines", 0), ("points", 1), ("lines", 1),
+                          ("points", 2), ("lines", 2)])
+        sigma = [1.5, 1.5 * (1 + 7e-4), 1.5 * (1 - 7e-4)]  # config/euroc.yaml's 1.5, nudged
+        for r in results:
+            argv = json.loads((out / "sim_A" / r["variant"] / f"r{r['repeat']}" /
+                               "argv.json").read_text())
+            sets = [argv[i + 1] for i, x in enumerate(argv) if x == "--set"]
+            if r["repeat"] == 0:
+                self.assertEqual(sets, [])
+            else:
+                (kv,) = sets
+                self.assertAlmostEqual(float(kv.split("=")[1]), sigma[r["repeat"]], places=9)
+        rows = table_rows(p.stdout.split("\n\n")[0])
+        self.assertEqual([row[:2] for row in rows], [["sim_A", "points"], ["sim_A", "lines"]])
+        for row in rows:
+            base = self.inputs["sim_A", row[1]]["summary"]["ate_rmse_m"]
+            ates = [base * s / 1.5 for s in sigma]
+            self.assertEqual(row[2], f"{np.mean(ates):.4f} ({min(ates):.4f}–{max(ates):.4f})")
+        self.assertIn("3 runs with estimator.point_sigma_px scaled", p.stdout)
 
     def test_missing_sequence_names_it(self):
         p = self.bench("--sequences", "sim_nowhere")
