@@ -19,12 +19,35 @@ a raw motion-capture track is not, and then only the long intervals mean anythin
 """
 import argparse
 import sys
+import warnings
 from pathlib import Path
 
 import numpy as np
 
 GRAVITY = 9.81
 INTERVALS_S = (0.05, 0.1, 0.25, 0.5, 1.0)
+# The columns read from each file (further columns are ignored).
+IMU_COLUMNS = ("timestamp", "w_RS_S_x", "w_RS_S_y", "w_RS_S_z", "a_RS_S_x", "a_RS_S_y", "a_RS_S_z")
+TUM_COLUMNS = ("timestamp", "tx", "ty", "tz", "qx", "qy", "qz", "qw")
+EUROC_GT_COLUMNS = ("timestamp", "p_RS_R_x", "p_RS_R_y", "p_RS_R_z", "q_RS_w", "q_RS_x", "q_RS_y",
+                    "q_RS_z")
+
+
+def load_table(path, columns, delimiter=None):
+    """The numbers of a text file ('#' comments), one row per line, at least len(columns)
+    columns; exits with a message naming the file if it cannot be read, is empty or is short."""
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # numpy warns about an empty file
+            a = np.loadtxt(path, delimiter=delimiter, comments="#", ndmin=2)
+    except (OSError, ValueError) as e:
+        sys.exit(f"imu_noise: {path}: cannot read: {e}")
+    if len(a) == 0:
+        sys.exit(f"imu_noise: {path} has no data rows")
+    if a.shape[1] < len(columns):
+        sys.exit(f"imu_noise: {path} has {a.shape[1]} columns, no {columns[a.shape[1]]} "
+                 f"(column {a.shape[1] + 1} of {', '.join(columns)})")
+    return a
 
 
 def quat_to_matrix(q):
@@ -50,12 +73,12 @@ def load_ground_truth(folder):
     """(t [s], p (N,3), q xyzw (N,4)) from groundtruth.tum or the EuRoC csv."""
     tum = folder / "groundtruth.tum"
     if tum.exists():
-        a = np.loadtxt(tum, comments="#")
+        a = load_table(tum, TUM_COLUMNS)
         return a[:, 0], a[:, 1:4], a[:, 4:8]
     csv = folder / "mav0" / "state_groundtruth_estimate0" / "data.csv"
     if not csv.exists():
         sys.exit(f"imu_noise: no ground truth in {folder} (groundtruth.tum or {csv})")
-    a = np.loadtxt(csv, delimiter=",", comments="#")
+    a = load_table(csv, EUROC_GT_COLUMNS, delimiter=",")
     return a[:, 0] * 1e-9, a[:, 1:4], a[:, [5, 6, 7, 4]]  # EuRoC stores w first
 
 
@@ -73,7 +96,7 @@ def main():
     imu_csv = args.dataset / "mav0" / "imu0" / "data.csv"
     if not imu_csv.exists():
         sys.exit(f"imu_noise: {imu_csv} not found")
-    imu = np.loadtxt(imu_csv, delimiter=",", comments="#")
+    imu = load_table(imu_csv, IMU_COLUMNS, delimiter=",")
     t_imu = imu[:, 0] * 1e-9
     t_gt, p_gt, q_gt = load_ground_truth(args.dataset)
 

@@ -11,6 +11,8 @@ import sys
 
 from bench import percentile  # scripts/bench.py: linear interpolation over sorted values
 
+FIELDS = ["state", "frames", "dropped_frames", "frontend_ms", "estimator_ms", "latency_ms"]
+
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -24,7 +26,11 @@ def main():
     statuses = []
     try:
         with rosbag.Bag(args.bag) as bag:
-            for _, m, _ in bag.read_messages():
+            for topic, m, _ in bag.read_messages():
+                missing = [k for k in FIELDS if not hasattr(m, k)]
+                if missing:  # another message type, or a status from before a field was added
+                    sys.exit(f"latency.py: {args.bag}: {topic} ({m._type}) has no field "
+                             f"{', '.join(missing)}")
                 statuses.append(m)
     except Exception as e:  # rosbag raises several types for a bad file
         sys.exit(f"latency.py: {args.bag}: cannot read: {e}")

@@ -11,14 +11,22 @@ import matplotlib
 matplotlib.use("Agg")  # no display needed
 import matplotlib.pyplot as plt  # noqa: E402
 
+COLUMNS = ["t", "est_x", "est_y", "gt_x", "gt_y", "error_m"]  # the columns plotted
+
 
 def main(out_dir):
     path = os.path.join(out_dir, "ate_pairs.csv")
-    with open(path) as f:
-        rows = list(csv.DictReader(f))
+    try:
+        with open(path) as f:
+            rows = list(csv.DictReader(f))
+    except OSError as e:
+        sys.exit(f"{path}: {e.strerror}")
     if not rows:
         sys.exit(f"{path}: no rows")
-    col = {k: [float(r[k]) for r in rows] for k in rows[0]}
+    missing = [k for k in COLUMNS if k not in rows[0]]
+    if missing:
+        sys.exit(f"{path}: no column {', '.join(missing)}")
+    col = {k: [float(r[k]) for r in rows] for k in COLUMNS}
     t0 = col["t"][0]
     t = [x - t0 for x in col["t"]]
 

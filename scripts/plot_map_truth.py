@@ -25,11 +25,21 @@ ENDPOINTS = ["x0", "y0", "x1", "y1"]
 
 
 def read_lines(path):
-    with open(path) as f:
-        rows = list(csv.DictReader(f))
-    if rows and any(k not in rows[0] for k in ENDPOINTS + ["precision_with_texture_edges"]):
+    try:
+        with open(path) as f:
+            reader = csv.DictReader(f)
+            columns = reader.fieldnames or []  # none in an empty file
+            rows = list(reader)
+    except OSError as e:
+        sys.exit(f"plot_map_truth: {path}: {e.strerror}")
+    missing = [k for k in ENDPOINTS + ["precision_with_texture_edges"] if k not in columns]
+    if missing:
         sys.exit(f"plot_map_truth: {path} has no endpoint or precision_with_texture_edges "
-                 "columns (write it with a current alvio_map_truth --per-line)")
+                 f"columns (no {', '.join(missing)}; write it with a current alvio_map_truth "
+                 "--per-line)")
+    if "length_m" not in columns:
+        sys.exit(f"plot_map_truth: {path} has no length_m column (write it with alvio_map_truth "
+                 "--per-line)")
     return rows
 
 
@@ -39,10 +49,13 @@ def read_scene_edges(sequence):
         sys.exit(f"plot_map_truth: {path} does not exist (a simulator sequence has one)")
     edges = []
     with open(path) as f:
-        for row in f:
+        for number, row in enumerate(f, 1):
             if row.startswith("#"):
                 continue
             v = row.strip().split(",")
+            if len(v) < 6:
+                sys.exit(f"plot_map_truth: {path} line {number} has {len(v)} columns, not "
+                         "id,ax,ay,az,bx,by,...")
             edges.append([(float(v[1]), float(v[2])), (float(v[4]), float(v[5]))])
     return edges
 

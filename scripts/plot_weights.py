@@ -17,6 +17,8 @@ import matplotlib
 matplotlib.use("Agg")  # no display needed
 import matplotlib.pyplot as plt  # noqa: E402
 
+COLUMNS = ["t", "w_p", "w_l", "alpha", "points_used", "lines_used"]  # the columns plotted
+
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -27,7 +29,11 @@ def main():
     if not stats.exists():
         sys.exit(f"plot-weights: {stats} does not exist (alvio run writes it)")
     with open(stats) as f:
-        rows = [r for r in csv.DictReader(f) if float(r["w_p"] or 0) + float(r["w_l"] or 0) > 0]
+        reader = csv.DictReader(f)
+        missing = [k for k in COLUMNS if k not in (reader.fieldnames or [])]
+        if missing:
+            sys.exit(f"plot-weights: {stats} has no column {', '.join(missing)}")
+        rows = [r for r in reader if float(r["w_p"] or 0) + float(r["w_l"] or 0) > 0]
     if not rows:
         sys.exit(f"plot-weights: no optimised frames in {stats}")
     t0 = float(rows[0]["t"])

@@ -184,6 +184,45 @@ class ImuNoiseTest(unittest.TestCase):
         csv = Path(tmp) / "mav0" / "state_groundtruth_estimate0" / "data.csv"
         self.assertIn(str(csv), p.stderr)
 
+    def assertFailsCleanly(self, p, *texts):
+        self.assertNotEqual(p.returncode, 0)
+        for text in texts:
+            self.assertIn(str(text), p.stderr)
+        self.assertNotIn("Traceback", p.stderr)
+        self.assertEqual(len(p.stderr.strip().splitlines()), 1, p.stderr)
+
+    def run_with(self, replace, tum=True):
+        """imu_noise.py on a short dataset with the files of replace ({relative path: text})
+        written over its own."""
+        with tempfile.TemporaryDirectory() as tmp:
+            make_dataset(Path(tmp), GYRO_DENSITY, ACCEL_DENSITY, seed=6, tum=tum, duration_s=6)
+            for name, text in replace.items():
+                (Path(tmp) / name).write_text(text)
+            return run(tmp), Path(tmp)
+
+    def test_empty_imu(self):
+        imu = Path("mav0") / "imu0" / "data.csv"
+        for text in ("", "#timestamp [ns],w_RS_S_x [rad s^-1]\n"):
+            p, folder = self.run_with({imu: text})
+            self.assertFailsCleanly(p, f"{folder / imu} has no data rows")
+
+    def test_imu_missing_columns(self):
+        imu = Path("mav0") / "imu0" / "data.csv"
+        p, folder = self.run_with({imu: "".join(f"{1600000000000000000 + k * 5000000},0.1,0.2,0.3\n"
+                                                for k in range(2000))})
+        self.assertFailsCleanly(p, f"{folder / imu} has 4 columns, no a_RS_S_x (column 5")
+
+    def test_empty_ground_truth(self):
+        p, folder = self.run_with({"groundtruth.tum": "# timestamp tx ty tz qx qy qz qw\n"})
+        self.assertFailsCleanly(p, f"{folder / 'groundtruth.tum'} has no data rows")
+
+    def test_ground_truth_missing_columns(self):
+        p, folder = self.run_with({"groundtruth.tum": "1600000000.0 0 0 0\n1600000001.0 0 0 0\n"})
+        self.assertFailsCleanly(p, f"{folder / 'groundtruth.tum'} has 4 columns, no qx (column 5")
+        gt = Path("mav0") / "state_groundtruth_estimate0" / "data.csv"
+        p, folder = self.run_with({gt: "1600000000000000000,0,0,0,1,0,0\n"}, tum=False)
+        self.assertFailsCleanly(p, f"{folder / gt} has 7 columns, no q_RS_z (column 8")
+
     def test_too_short_overlap(self):
         with tempfile.TemporaryDirectory() as tmp:
             make_dataset(Path(tmp), GYRO_DENSITY, ACCEL_DENSITY, seed=5, duration_s=3)

@@ -26,10 +26,18 @@ except ImportError as e:  # no ROS python packages (python3-rosbag, python3-genp
     IMPORT_ERROR = str(e)
 
 
-def status_class():
+def status_class(without=None):
     """alvio/PipelineStatus from the package's .msg file, with std_msgs/Header appended as
-    gen_msg does, so no build tree is needed."""
+    gen_msg does, so no build tree is needed; without: leave out the lines of this field (as
+    in a status recorded before the field was added)."""
     text = (ROOT / "msg" / "PipelineStatus.msg").read_text()
+    if without:
+        lines = text.splitlines()
+        k = next(i for i, line in enumerate(lines) if line.split()[1:2] == [without])
+        end = k + 1  # and the comment lines that continue the field's comment
+        while end < len(lines) and lines[end].lstrip().startswith("#"):
+            end += 1
+        text = "\n".join(lines[:k] + lines[end:]) + "\n"
     full = text + "\n" + "=" * 80 + "\nMSG: std_msgs/Header\n" + std_msgs.msg.Header._full_text
     return genpy.dynamic.generate_dynamic("alvio/PipelineStatus", full)["alvio/PipelineStatus"]
 
@@ -56,11 +64,11 @@ class LatencyTest(unittest.TestCase):
     def tearDown(self):
         self.tmp.cleanup()
 
-    def write_bag(self, name, messages):
+    def write_bag(self, name, messages, message_class=None):
         path = self.dir / name
         with rosbag.Bag(str(path), "w") as bag:
             for k, fields in enumerate(messages):
-                m = self.Status(**fields)
+                m = (message_class or self.Status)(**fields)
                 m.header.stamp = genpy.Time(1600000000 + k // 20, (k % 20) * 50_000_000)
                 m.header.frame_id = "world"
                 bag.write("/alvio/status", m, t=m.header.stamp)
@@ -129,6 +137,30 @@ class LatencyTest(unittest.TestCase):
         self.assertNotEqual(p.returncode, 0)
         self.assertIn(f"{bag}: cannot read", p.stderr)
         self.assertNotIn("Traceback", p.stderr)
+
+    def assertFailsCleanly(self, p, *texts):
+        self.assertNotEqual(p.returncode, 0)
+        for text in texts:
+            self.assertIn(str(text), p.stderr)
+        self.assertNotIn("Traceback", p.stderr)
+        self.assertEqual(len(p.stderr.strip().splitlines()), 1, p.stderr)
+
+    def test_status_without_a_field(self):
+        # A bag recorded before PipelineStatus had latency_ms.
+        old = status_class(without="latency_ms")
+        self.assertFalse(hasattr(old(), "latency_ms"))
+        msgs = [dict(state="tracking", frames=k + 1, frontend_ms=3.0, estimator_ms=5.0)
+                for k in range(5)]
+        bag = self.write_bag("old.bag", msgs, old)
+        self.assertFailsCleanly(run_latency(bag), f"{bag}: /alvio/status (alvio/PipelineStatus) "
+                                                  "has no field latency_ms")
+
+    def test_not_status_messages(self):
+        bag = self.dir / "strings.bag"
+        with rosbag.Bag(str(bag), "w") as b:
+            b.write("/chatter", std_msgs.msg.String(data="hello"), t=genpy.Time(1600000000))
+        self.assertFailsCleanly(run_latency(bag), f"{bag}: /chatter (std_msgs/String) has no "
+                                                  "field state, frames")
 
     def test_missing_bag(self):
         bag = self.dir / "nowhere.bag"

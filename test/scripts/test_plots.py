@@ -73,9 +73,12 @@ class PlotTestCase(unittest.TestCase):
         return pixels
 
     def assertFails(self, process, *texts):
+        """A non-zero exit with a one-line message holding each text, not a traceback."""
         self.assertNotEqual(process.returncode, 0)
         for text in texts:
             self.assertIn(str(text), process.stderr)
+        self.assertNotIn("Traceback", process.stderr)
+        self.assertEqual(len(process.stderr.strip().splitlines()), 1, process.stderr)
 
 
 class PlotEvalTest(PlotTestCase):
@@ -124,7 +127,15 @@ class PlotEvalTest(PlotTestCase):
 
     def test_missing_csv(self):
         (self.dir / "ate_pairs.csv").unlink()
-        self.assertFails(run_script("plot_eval.py", self.dir), self.dir / "ate_pairs.csv")
+        self.assertFails(run_script("plot_eval.py", self.dir),
+                         f"{self.dir / 'ate_pairs.csv'}: No such file or directory")
+
+    def test_missing_column(self):
+        header = [k for k in self.HEADER if k != "error_m"]
+        write_csv(self.dir / "ate_pairs.csv", header, [[1.0] * len(header)] * 3)
+        self.assertFails(run_script("plot_eval.py", self.dir),
+                         f"{self.dir / 'ate_pairs.csv'}: no column error_m")
+        self.assertFalse((self.dir / "trajectory_top.png").exists())
 
     def test_usage(self):
         self.assertFails(run_script("plot_eval.py"), "usage: plot_eval.py DIR")
@@ -186,6 +197,13 @@ class PlotWeightsTest(PlotTestCase):
         (self.run_dir / "frame_stats.csv").unlink()
         self.assertFails(run_script("plot_weights.py", self.run_dir),
                          f"{self.run_dir / 'frame_stats.csv'} does not exist")
+
+    def test_missing_column(self):
+        header = [k for k in self.HEADER if k != "w_p"]
+        write_csv(self.run_dir / "frame_stats.csv", header, [[1] * len(header)] * 3)
+        self.assertFails(run_script("plot_weights.py", self.run_dir),
+                         f"{self.run_dir / 'frame_stats.csv'} has no column w_p")
+        self.assertFalse((self.run_dir / "weights.png").exists())
 
     def test_no_optimised_frames(self):
         write_csv(self.run_dir / "frame_stats.csv", self.HEADER,
@@ -273,10 +291,40 @@ class PlotMapTruthTest(PlotTestCase):
         self.assertFails(p, f"{old} has no endpoint or precision_with_texture_edges columns")
         self.assertFalse((self.dir / "x.png").exists())
 
+    def test_old_per_line_file_names_the_missing_columns(self):
+        old = self.dir / "old.csv"
+        write_csv(old, [k for k in self.HEADER if k not in ("x1", "y1")], [])  # header only
+        p = run_script("plot_map_truth.py", self.a, old, "--out", self.dir / "x.png")
+        self.assertFails(p, f"{old} has no endpoint or precision_with_texture_edges columns "
+                            "(no x1, y1;")
+        self.assertFalse((self.dir / "x.png").exists())
+
+    def test_missing_length_column(self):
+        short = self.dir / "short.csv"
+        write_csv(short, [k for k in self.HEADER if k != "length_m"], [[1] * 17])
+        p = run_script("plot_map_truth.py", short, "--out", self.dir / "x.png")
+        self.assertFails(p, f"{short} has no length_m column")
+        self.assertFalse((self.dir / "x.png").exists())
+
+    def test_empty_per_line_file(self):
+        empty = self.dir / "empty.csv"
+        empty.write_text("")
+        p = run_script("plot_map_truth.py", empty, "--out", self.dir / "x.png")
+        self.assertFails(p, f"{empty} has no endpoint or precision_with_texture_edges columns")
+        self.assertFalse((self.dir / "x.png").exists())
+
     def test_missing_per_line_file(self):
         missing = self.dir / "nowhere.csv"
-        p = run_script("plot_map_truth.py", missing, "--out", self.dir / "x.png")
-        self.assertFails(p, missing)
+        p = run_script("plot_map_truth.py", self.a, missing, "--out", self.dir / "x.png")
+        self.assertFails(p, f"{missing}: No such file or directory")
+        self.assertFalse((self.dir / "x.png").exists())
+
+    def test_short_scene_edges_row(self):
+        with open(self.sequence / "scene_edges.csv", "a") as f:
+            f.write("7,1.0,2.0\n")
+        p = run_script("plot_map_truth.py", self.a, "--out", self.dir / "x.png",
+                       "--sequence", self.sequence)
+        self.assertFails(p, f"{self.sequence / 'scene_edges.csv'} line 4 has 3 columns")
         self.assertFalse((self.dir / "x.png").exists())
 
     def test_sequence_without_scene_edges(self):
