@@ -25,11 +25,6 @@ using Clock = std::chrono::steady_clock;
 
 namespace {
 
-std::string readFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
-
 // alvio_run in the background, its stdout and stderr in files.
 pid_t startRun(const std::vector<std::string>& args, const std::string& log_prefix) {
   const pid_t pid = fork();
@@ -93,12 +88,12 @@ void expectCompleteOutputs(const std::string& out) {
                         "summary.json", "octomap.bt", "lines.csv", "lines.ply", "map.3Dscene",
                         "alvio.rawlog", "alvio.3Dscene", "alvio.log"})
     EXPECT_TRUE(fs::exists(fs::path(out) / f)) << f;
-  const auto summary = nlohmann::json::parse(readFile(out + "/summary.json"));
+  const auto summary = nlohmann::json::parse(test::readFile(out + "/summary.json"));
   const std::size_t frames = summary["frames"];
   // timing.csv: a header and a row per processed frame.
-  const std::string timing = readFile(out + "/timing.csv");
+  const std::string timing = test::readFile(out + "/timing.csv");
   EXPECT_EQ(static_cast<std::size_t>(std::count(timing.begin(), timing.end(), '\n')), frames + 1);
-  EXPECT_EQ(readFile(out + "/trajectory.tum").rfind("# timestamp", 0), 0u);
+  EXPECT_EQ(test::readFile(out + "/trajectory.tum").rfind("# timestamp", 0), 0u);
   mrpt::obs::CRawlog rawlog;
   ASSERT_TRUE(expectSavedFilesLoad(out, &rawlog));
   std::size_t imu = 0;
@@ -108,7 +103,7 @@ void expectCompleteOutputs(const std::string& out) {
   // 200 Hz IMU, 20 Hz frames: the IMU up to the stop is in the rawlog, and no more.
   EXPECT_GE(imu, 8 * frames);
   EXPECT_LE(imu, 10 * frames + 20);
-  EXPECT_NE(readFile(out + "/alvio.log").find("logger closed"), std::string::npos);
+  EXPECT_NE(test::readFile(out + "/alvio.log").find("logger closed"), std::string::npos);
   for (const auto& e : fs::directory_iterator(out)) {
     const std::string ext = e.path().extension().string();
     EXPECT_TRUE(ext != ".tmp" && ext != ".part") << "left over: " << e.path();
@@ -131,13 +126,13 @@ TEST(NothingLost, StopSignalMidRunWritesEverything) {
     // The progress lines (stderr is not a terminal) say how far it got.
     bool exited = false;
     const bool third = waitUntil(
-        pid, [&] { return readFile(dir + "/run.err").find(" 30% ") != std::string::npos; }, 300,
-        &exited);
-    ASSERT_TRUE(third) << "never reached 30 %: " << readFile(dir + "/run.err");
+        pid, [&] { return test::readFile(dir + "/run.err").find(" 30% ") != std::string::npos; },
+        300, &exited);
+    ASSERT_TRUE(third) << "never reached 30 %: " << test::readFile(dir + "/run.err");
     kill(pid, signo);
-    EXPECT_EQ(waitExitCode(pid), 128 + signo) << readFile(dir + "/run.err");
-    EXPECT_NE(readFile(dir + "/run.out").find("interrupted by signal"), std::string::npos);
-    const auto summary = nlohmann::json::parse(readFile(out + "/summary.json"));
+    EXPECT_EQ(waitExitCode(pid), 128 + signo) << test::readFile(dir + "/run.err");
+    EXPECT_NE(test::readFile(dir + "/run.out").find("interrupted by signal"), std::string::npos);
+    const auto summary = nlohmann::json::parse(test::readFile(out + "/summary.json"));
     EXPECT_TRUE(summary["interrupted"].get<bool>());
     EXPECT_GE(summary["frames"].get<int>(), 28);
     EXPECT_LT(summary["frames"].get<int>(), 95) << "the signal did not stop the run early";
@@ -191,7 +186,7 @@ TEST(NothingLost, SigkillDuringSaveKeepsPreviousFile) {
     int mid_save_kills = 0;
     for (int trial = 0; trial < 3; ++trial) {
       w.save(path, 0);
-      const std::string before = readFile(path);
+      const std::string before = test::readFile(path);
       const pid_t pid = fork();
       if (pid == 0) {
         w.save(path, 1);
@@ -208,7 +203,7 @@ TEST(NothingLost, SigkillDuringSaveKeepsPreviousFile) {
       // Killed while writing: the old file is untouched.
       if (fs::exists(path + ".tmp")) {
         ++mid_save_kills;
-        EXPECT_EQ(readFile(path), before) << "trial " << trial;
+        EXPECT_EQ(test::readFile(path), before) << "trial " << trial;
       }
       EXPECT_NO_THROW(w.load(path));
       fs::remove(path + ".tmp");
@@ -227,7 +222,7 @@ TEST(NothingLost, SigkillDuringRunSaveKeepsPreviousMaps) {
   const std::string dir = test::scratchDir();
   const std::string out = dir + "/out";
   const pid_t first = startRun({"--dataset", data, "--out", out, "--max-frames", "15"}, dir + "/1");
-  ASSERT_EQ(waitExitCode(first), 3) << readFile(dir + "/1.err");  // 3: no poses (static)
+  ASSERT_EQ(waitExitCode(first), 3) << test::readFile(dir + "/1.err");  // 3: no poses (static)
   const auto saving = [&] {
     for (const char* f : {"octomap.bt", "lines.csv", "lines.ply", "map.3Dscene", "alvio.3Dscene"})
       if (fs::exists(out + "/" + f + ".tmp")) return true;
@@ -235,23 +230,23 @@ TEST(NothingLost, SigkillDuringRunSaveKeepsPreviousMaps) {
   };
   // Killed mid-run: the rawlog being streamed is the .part, the first run's is intact.
   {
-    const std::string rawlog_before = readFile(out + "/alvio.rawlog");
+    const std::string rawlog_before = test::readFile(out + "/alvio.rawlog");
     const pid_t run = startRun({"--dataset", data, "--out", out}, dir + "/mid");
     bool exited = false;
     ASSERT_TRUE(waitUntil(
-        run, [&] { return readFile(dir + "/mid.err").find(" 30% ") != std::string::npos; }, 300,
-        &exited));
+        run, [&] { return test::readFile(dir + "/mid.err").find(" 30% ") != std::string::npos; },
+        300, &exited));
     kill(run, SIGKILL);
     EXPECT_EQ(waitExitCode(run), 1000 + SIGKILL);
     EXPECT_TRUE(fs::exists(out + "/alvio.rawlog.part"));
-    EXPECT_EQ(readFile(out + "/alvio.rawlog"), rawlog_before);
+    EXPECT_EQ(test::readFile(out + "/alvio.rawlog"), rawlog_before);
     mrpt::obs::CRawlog rawlog;
     EXPECT_TRUE(rawlog.loadFromRawLogFile(out + "/alvio.rawlog"));
   }
   bool killed_mid_save = false;
   for (int attempt = 0; attempt < 5 && !killed_mid_save; ++attempt) {
     SCOPED_TRACE(attempt);
-    const std::string rawlog_before = readFile(out + "/alvio.rawlog");
+    const std::string rawlog_before = test::readFile(out + "/alvio.rawlog");
     ASSERT_FALSE(rawlog_before.empty());
     const pid_t run = startRun({"--dataset", data, "--out", out, "--max-frames", "30"}, dir + "/2");
     bool exited = false;
@@ -263,7 +258,7 @@ TEST(NothingLost, SigkillDuringRunSaveKeepsPreviousMaps) {
     // The logger finishes (renaming its rawlog) before the map is saved: either rawlog
     // is complete, and a leftover part means the old one is untouched.
     if (fs::exists(out + "/alvio.rawlog.part")) {
-      EXPECT_EQ(readFile(out + "/alvio.rawlog"), rawlog_before);
+      EXPECT_EQ(test::readFile(out + "/alvio.rawlog"), rawlog_before);
     }
     mrpt::obs::CRawlog rawlog;
     EXPECT_TRUE(expectSavedFilesLoad(out, &rawlog));

@@ -12,16 +12,7 @@
 using namespace alvio;
 namespace fs = std::filesystem;
 
-namespace {
-int run(const std::string& cmd, std::string* out) {
-  FILE* pipe = popen((cmd + " 2>&1").c_str(), "r");
-  if (!pipe) return -1;
-  char buf[4096];
-  while (fgets(buf, sizeof buf, pipe)) *out += buf;
-  const int status = pclose(pipe);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-}  // namespace
+using test::runCommand;
 
 TEST(RunMap, OfflineRunnerWritesReadableMapFiles) {
   ALVIO_REQUIRE_SHARED_DATA(data);
@@ -30,9 +21,10 @@ TEST(RunMap, OfflineRunnerWritesReadableMapFiles) {
   const std::string out = test::scratchDir() + "/run";
   std::string log;
   // Exit code 3: no poses (the slice is static); the files must be there all the same.
-  const int rc = run(std::string(ALVIO_BIN_DIR) + "/alvio_run --quiet --max-frames 30 --dataset '" +
-                         dataset + "' --out '" + out + "'",
-                     &log);
+  const int rc =
+      runCommand(std::string(ALVIO_BIN_DIR) + "/alvio_run --quiet --max-frames 30 --dataset '" +
+                     dataset + "' --out '" + out + "'",
+                 &log);
   ASSERT_TRUE(rc == 0 || rc == 3) << log;
   EXPECT_NE(log.find("map:"), std::string::npos) << log;
   for (const char* f : {kOctomapFileName, kLinesPlyFileName, kLinesCsvFileName, kSceneFileName})
@@ -42,7 +34,8 @@ TEST(RunMap, OfflineRunnerWritesReadableMapFiles) {
   EXPECT_TRUE(readLinesCsv((fs::path(out) / kLinesCsvFileName).string()).empty());
 
   std::string info;
-  ASSERT_EQ(run(std::string(ALVIO_BIN_DIR) + "/alvio_map_info '" + out + "'", &info), 0) << info;
+  ASSERT_EQ(runCommand(std::string(ALVIO_BIN_DIR) + "/alvio_map_info '" + out + "'", &info), 0)
+      << info;
   EXPECT_NE(info.find("lines: 0"), std::string::npos) << info;
   EXPECT_NE(info.find("voxels (0.050 m): 0 occupied"), std::string::npos) << info;
 }

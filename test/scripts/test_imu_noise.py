@@ -12,6 +12,8 @@ from pathlib import Path
 
 import numpy as np
 
+from script_failures import CleanFailureAssertions  # test/scripts/, on the path
+
 SCRIPT = Path(__file__).resolve().parents[2] / "scripts" / "imu_noise.py"
 INTERVALS_S = np.array([0.05, 0.1, 0.25, 0.5, 1.0])  # the script's columns
 RATE_HZ = 200.0
@@ -107,7 +109,7 @@ def table(stdout):
     return rows
 
 
-class ImuNoiseTest(unittest.TestCase):
+class ImuNoiseTest(CleanFailureAssertions, unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         cls.tmp = tempfile.TemporaryDirectory()
@@ -183,13 +185,6 @@ class ImuNoiseTest(unittest.TestCase):
         self.assertIn("no ground truth in " + tmp, p.stderr)
         csv = Path(tmp) / "mav0" / "state_groundtruth_estimate0" / "data.csv"
         self.assertIn(str(csv), p.stderr)
-
-    def assertFailsCleanly(self, p, *texts):
-        self.assertNotEqual(p.returncode, 0)
-        for text in texts:
-            self.assertIn(str(text), p.stderr)
-        self.assertNotIn("Traceback", p.stderr)
-        self.assertEqual(len(p.stderr.strip().splitlines()), 1, p.stderr)
 
     def run_with(self, replace, tum=True):
         """imu_noise.py on a short dataset with the files of replace ({relative path: text})

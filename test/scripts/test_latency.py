@@ -13,6 +13,8 @@ from pathlib import Path
 
 import numpy as np
 
+from script_failures import CleanFailureAssertions  # test/scripts/, on the path
+
 ROOT = Path(__file__).resolve().parents[2]
 SCRIPT = ROOT / "scripts" / "latency.py"
 
@@ -48,7 +50,7 @@ def run_latency(*args):
                           text=True, env=env, timeout=60)
 
 
-class LatencyTest(unittest.TestCase):
+class LatencyTest(CleanFailureAssertions, unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         if rosbag is None:
@@ -137,13 +139,6 @@ class LatencyTest(unittest.TestCase):
         self.assertNotEqual(p.returncode, 0)
         self.assertIn(f"{bag}: cannot read", p.stderr)
         self.assertNotIn("Traceback", p.stderr)
-
-    def assertFailsCleanly(self, p, *texts):
-        self.assertNotEqual(p.returncode, 0)
-        for text in texts:
-            self.assertIn(str(text), p.stderr)
-        self.assertNotIn("Traceback", p.stderr)
-        self.assertEqual(len(p.stderr.strip().splitlines()), 1, p.stderr)
 
     def test_status_without_a_field(self):
         # A bag recorded before PipelineStatus had latency_ms.

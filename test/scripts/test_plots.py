@@ -22,6 +22,7 @@ import matplotlib.figure  # noqa: E402
 import matplotlib.image  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from script_failures import CleanFailureAssertions  # noqa: E402 (test/scripts/, on the path)
 
 SCRIPTS = Path(__file__).resolve().parents[2] / "scripts"
 sys.dont_write_bytecode = True  # keep scripts/ free of __pycache__
@@ -54,7 +55,7 @@ def write_csv(path, header, rows):
         w.writerows(rows)
 
 
-class PlotTestCase(unittest.TestCase):
+class PlotTestCase(CleanFailureAssertions, unittest.TestCase):
     def setUp(self):
         self.tmp = tempfile.TemporaryDirectory()
         self.dir = Path(self.tmp.name)
@@ -71,14 +72,6 @@ class PlotTestCase(unittest.TestCase):
         pixels = matplotlib.image.imread(path)
         self.assertEqual(pixels.shape[:2], (height, width))
         return pixels
-
-    def assertFails(self, process, *texts):
-        """A non-zero exit with a one-line message holding each text, not a traceback."""
-        self.assertNotEqual(process.returncode, 0)
-        for text in texts:
-            self.assertIn(str(text), process.stderr)
-        self.assertNotIn("Traceback", process.stderr)
-        self.assertEqual(len(process.stderr.strip().splitlines()), 1, process.stderr)
 
 
 class PlotEvalTest(PlotTestCase):
@@ -121,24 +114,24 @@ class PlotEvalTest(PlotTestCase):
 
     def test_empty_csv(self):
         write_csv(self.dir / "ate_pairs.csv", self.HEADER, [])
-        self.assertFails(run_script("plot_eval.py", self.dir),
+        self.assertFailsCleanly(run_script("plot_eval.py", self.dir),
                          f"{self.dir / 'ate_pairs.csv'}: no rows")
         self.assertFalse((self.dir / "trajectory_top.png").exists())
 
     def test_missing_csv(self):
         (self.dir / "ate_pairs.csv").unlink()
-        self.assertFails(run_script("plot_eval.py", self.dir),
+        self.assertFailsCleanly(run_script("plot_eval.py", self.dir),
                          f"{self.dir / 'ate_pairs.csv'}: No such file or directory")
 
     def test_missing_column(self):
         header = [k for k in self.HEADER if k != "error_m"]
         write_csv(self.dir / "ate_pairs.csv", header, [[1.0] * len(header)] * 3)
-        self.assertFails(run_script("plot_eval.py", self.dir),
+        self.assertFailsCleanly(run_script("plot_eval.py", self.dir),
                          f"{self.dir / 'ate_pairs.csv'}: no column error_m")
         self.assertFalse((self.dir / "trajectory_top.png").exists())
 
     def test_usage(self):
-        self.assertFails(run_script("plot_eval.py"), "usage: plot_eval.py DIR")
+        self.assertFailsCleanly(run_script("plot_eval.py"), "usage: plot_eval.py DIR")
 
 
 class PlotWeightsTest(PlotTestCase):
@@ -195,20 +188,20 @@ class PlotWeightsTest(PlotTestCase):
 
     def test_missing_frame_stats(self):
         (self.run_dir / "frame_stats.csv").unlink()
-        self.assertFails(run_script("plot_weights.py", self.run_dir),
+        self.assertFailsCleanly(run_script("plot_weights.py", self.run_dir),
                          f"{self.run_dir / 'frame_stats.csv'} does not exist")
 
     def test_missing_column(self):
         header = [k for k in self.HEADER if k != "w_p"]
         write_csv(self.run_dir / "frame_stats.csv", header, [[1] * len(header)] * 3)
-        self.assertFails(run_script("plot_weights.py", self.run_dir),
+        self.assertFailsCleanly(run_script("plot_weights.py", self.run_dir),
                          f"{self.run_dir / 'frame_stats.csv'} has no column w_p")
         self.assertFalse((self.run_dir / "weights.png").exists())
 
     def test_no_optimised_frames(self):
         write_csv(self.run_dir / "frame_stats.csv", self.HEADER,
                   [[f"{100 + k:.6f}", 1, 1, 0, 0, "0", "0", "0"] for k in range(3)])
-        self.assertFails(run_script("plot_weights.py", self.run_dir),
+        self.assertFailsCleanly(run_script("plot_weights.py", self.run_dir),
                          f"no optimised frames in {self.run_dir / 'frame_stats.csv'}")
         self.assertFalse((self.run_dir / "weights.png").exists())
 
@@ -288,14 +281,14 @@ class PlotMapTruthTest(PlotTestCase):
         old = self.dir / "old.csv"
         write_csv(old, ["id", "length_m", "precision"], [[0, 1.0, 1.0]])
         p = run_script("plot_map_truth.py", old, "--out", self.dir / "x.png")
-        self.assertFails(p, f"{old} has no endpoint or precision_with_texture_edges columns")
+        self.assertFailsCleanly(p, f"{old} has no endpoint or precision_with_texture_edges columns")
         self.assertFalse((self.dir / "x.png").exists())
 
     def test_old_per_line_file_names_the_missing_columns(self):
         old = self.dir / "old.csv"
         write_csv(old, [k for k in self.HEADER if k not in ("x1", "y1")], [])  # header only
         p = run_script("plot_map_truth.py", self.a, old, "--out", self.dir / "x.png")
-        self.assertFails(p, f"{old} has no endpoint or precision_with_texture_edges columns "
+        self.assertFailsCleanly(p, f"{old} has no endpoint or precision_with_texture_edges columns "
                             "(no x1, y1;")
         self.assertFalse((self.dir / "x.png").exists())
 
@@ -303,20 +296,20 @@ class PlotMapTruthTest(PlotTestCase):
         short = self.dir / "short.csv"
         write_csv(short, [k for k in self.HEADER if k != "length_m"], [[1] * 17])
         p = run_script("plot_map_truth.py", short, "--out", self.dir / "x.png")
-        self.assertFails(p, f"{short} has no length_m column")
+        self.assertFailsCleanly(p, f"{short} has no length_m column")
         self.assertFalse((self.dir / "x.png").exists())
 
     def test_empty_per_line_file(self):
         empty = self.dir / "empty.csv"
         empty.write_text("")
         p = run_script("plot_map_truth.py", empty, "--out", self.dir / "x.png")
-        self.assertFails(p, f"{empty} has no endpoint or precision_with_texture_edges columns")
+        self.assertFailsCleanly(p, f"{empty} has no endpoint or precision_with_texture_edges columns")
         self.assertFalse((self.dir / "x.png").exists())
 
     def test_missing_per_line_file(self):
         missing = self.dir / "nowhere.csv"
         p = run_script("plot_map_truth.py", self.a, missing, "--out", self.dir / "x.png")
-        self.assertFails(p, f"{missing}: No such file or directory")
+        self.assertFailsCleanly(p, f"{missing}: No such file or directory")
         self.assertFalse((self.dir / "x.png").exists())
 
     def test_short_scene_edges_row(self):
@@ -324,19 +317,19 @@ class PlotMapTruthTest(PlotTestCase):
             f.write("7,1.0,2.0\n")
         p = run_script("plot_map_truth.py", self.a, "--out", self.dir / "x.png",
                        "--sequence", self.sequence)
-        self.assertFails(p, f"{self.sequence / 'scene_edges.csv'} line 4 has 3 columns")
+        self.assertFailsCleanly(p, f"{self.sequence / 'scene_edges.csv'} line 4 has 3 columns")
         self.assertFalse((self.dir / "x.png").exists())
 
     def test_sequence_without_scene_edges(self):
         (self.sequence / "scene_edges.csv").unlink()
         p = run_script("plot_map_truth.py", self.a, "--out", self.dir / "x.png",
                        "--sequence", self.sequence)
-        self.assertFails(p, f"{self.sequence / 'scene_edges.csv'} does not exist")
+        self.assertFailsCleanly(p, f"{self.sequence / 'scene_edges.csv'} does not exist")
 
     def test_title_count_must_match(self):
         p = run_script("plot_map_truth.py", self.a, self.b, "--out", self.dir / "x.png",
                        "--titles", "only one")
-        self.assertFails(p, "give one title per file")
+        self.assertFailsCleanly(p, "give one title per file")
 
 
 if __name__ == "__main__":

@@ -3,7 +3,12 @@
 #include <unistd.h>
 #include <cstdlib>
 
+#include <sys/wait.h>
+
+#include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <set>
 
 #include "alvio/common/error.h"
@@ -41,6 +46,21 @@ std::string errorOf(const std::function<void()>& f) {
   }
   ADD_FAILURE() << "expected alvio::Error";
   return "";
+}
+
+int runCommand(const std::string& command, std::string* out) {
+  out->clear();
+  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
+  if (!pipe) return -1;
+  char buf[4096];
+  while (fgets(buf, sizeof buf, pipe)) *out += buf;
+  const int status = pclose(pipe);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+std::string readFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
 }
 
 }  // namespace alvio::test

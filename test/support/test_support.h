@@ -18,6 +18,11 @@ std::string scratchDir();
 std::string sourcePath(const std::string& relative);
 /// The message of the alvio::Error that `f` throws ("" and a test failure when it throws none).
 std::string errorOf(const std::function<void()>& f);
+/// Run a shell command; its stdout and stderr together go to `out`. Returns the exit code,
+/// or -1 when it could not run or did not exit normally.
+int runCommand(const std::string& command, std::string* out);
+/// A file's bytes ("" when it cannot be read).
+std::string readFile(const std::string& path);
 
 }  // namespace alvio::test
 

@@ -24,11 +24,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string readFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
-
 std::string writeFile(const std::string& path, const std::string& text) {
   std::ofstream(path, std::ios::binary) << text;
   return path;
@@ -41,7 +36,7 @@ std::string writeFile(const std::string& path, const std::string& text) {
 // The default config with `from` replaced by `to`, written to dir/name.
 std::string configReplacing(const std::string& dir, const std::string& from,
                             const std::string& to) {
-  std::string text = readFile(test::sourcePath("config/euroc.yaml"));
+  std::string text = test::readFile(test::sourcePath("config/euroc.yaml"));
   const auto pos = text.find(from);
   EXPECT_NE(pos, std::string::npos) << from;
   if (pos != std::string::npos) text.replace(pos, from.size(), to);
@@ -226,7 +221,7 @@ TEST(BadDataset, TruncatedPngIsSkippedAndCounted) {
   const RunResult r = runOffline(source, defaultConfig(), quietRun(dir + "/out"));
   EXPECT_EQ(r.skipped_images, 2u);
   EXPECT_EQ(r.frames, 3u);
-  const auto summary = nlohmann::json::parse(readFile(dir + "/out/summary.json"));
+  const auto summary = nlohmann::json::parse(test::readFile(dir + "/out/summary.json"));
   EXPECT_EQ(summary["skipped_images"], 2);
   EXPECT_EQ(summary["frames"], 3);
 }
@@ -245,14 +240,14 @@ TEST(StillStart, WaitsForMotionAndPublishesNoPose) {
   EXPECT_EQ(r.frames, 95u);
   EXPECT_EQ(r.poses, 0u) << "a pose was published while standing still";
   EXPECT_FALSE(r.initialization.has_value());
-  const std::string events = readFile(out + "/events.log");
+  const std::string events = test::readFile(out + "/events.log");
   EXPECT_MENTIONS(events, " waiting ");
   EXPECT_EQ(events.find(" initialized "), std::string::npos) << events;
   // The waiting reasons say why: no excitation or no parallax, i.e. no motion.
   EXPECT_TRUE(events.find("excitation") != std::string::npos ||
               events.find("parallax") != std::string::npos)
       << events;
-  const auto summary = nlohmann::json::parse(readFile(out + "/summary.json"));
+  const auto summary = nlohmann::json::parse(test::readFile(out + "/summary.json"));
   EXPECT_EQ(summary["poses"], 0);
 }
 
@@ -345,7 +340,7 @@ TEST(BadStream, NonFiniteAndOutOfOrderMessagesAreDroppedAndCounted) {
   EXPECT_EQ(r.dropped_images, 2u);
   EXPECT_EQ(r.frames, 21u);  // every in-order image, none of the two from the past
   for (const auto& p : r.trajectory) EXPECT_TRUE(p.p.allFinite() && p.q.coeffs().allFinite());
-  const auto summary = nlohmann::json::parse(readFile(out + "/summary.json"));
+  const auto summary = nlohmann::json::parse(test::readFile(out + "/summary.json"));
   EXPECT_EQ(summary["dropped_imu"], expected_imu_drops);
   EXPECT_EQ(summary["dropped_images"], 2);
 }
@@ -365,7 +360,8 @@ TEST(BadStream, ClockJumpBackResetsAndContinuesOnTheNewClock) {
   EXPECT_EQ(r.frames, 41u) << "every image, on either clock, is tracked";
   EXPECT_EQ(r.dropped_images, 0u);
   EXPECT_EQ(r.dropped_imu, 0u);
-  EXPECT_NE(readFile(out + "/events.log").find("IMU clock jumped back 0.495 s"), std::string::npos);
+  EXPECT_NE(test::readFile(out + "/events.log").find("IMU clock jumped back 0.495 s"),
+            std::string::npos);
 }
 
 TEST(LogThrottle, OneLinePerPeriodCountingWhatItStandsFor) {

@@ -11,15 +11,7 @@
 
 using namespace alvio;
 
-namespace {
-int run(const std::string& cmd, std::string* out) {
-  FILE* pipe = popen((cmd + " 2>&1").c_str(), "r");
-  char buf[4096];
-  out->clear();
-  while (fgets(buf, sizeof(buf), pipe)) *out += buf;
-  return WEXITSTATUS(pclose(pipe));
-}
-}  // namespace
+using test::runCommand;
 
 TEST(EvalTool, PrintsMachineReadableLastLineAndWritesJsonAndPlots) {
   const std::string dir = test::scratchDir();
@@ -36,9 +28,9 @@ TEST(EvalTool, PrintsMachineReadableLastLineAndWritesJsonAndPlots) {
   writeTumTrajectory(dir + "/est.tum", est);
   std::string out;
   const std::string exe = std::string(ALVIO_BIN_DIR) + "/alvio_eval";
-  ASSERT_EQ(run(exe + " --gt " + dir + "/gt.tum --est " + dir + "/est.tum --json " + dir +
-                    "/r.json --plot " + dir + "/plots",
-                &out),
+  ASSERT_EQ(runCommand(exe + " --gt " + dir + "/gt.tum --est " + dir + "/est.tum --json " + dir +
+                           "/r.json --plot " + dir + "/plots",
+                       &out),
             0)
       << out;
   const std::string last = out.substr(out.rfind("ATE_RMSE="));
@@ -55,10 +47,10 @@ TEST(EvalTool, PrintsMachineReadableLastLineAndWritesJsonAndPlots) {
 TEST(EvalTool, BadInputGivesErrorAndNonZeroExit) {
   std::string out;
   const std::string exe = std::string(ALVIO_BIN_DIR) + "/alvio_eval";
-  EXPECT_NE(run(exe + " --gt /nonexistent.tum --est /nonexistent2.tum", &out), 0);
+  EXPECT_NE(runCommand(exe + " --gt /nonexistent.tum --est /nonexistent2.tum", &out), 0);
   EXPECT_NE(out.find("/nonexistent.tum"), std::string::npos) << out;
-  EXPECT_NE(run(exe + " --gt a --est b --align bogus", &out), 0);
+  EXPECT_NE(runCommand(exe + " --gt a --est b --align bogus", &out), 0);
   EXPECT_NE(out.find("bogus"), std::string::npos) << out;
-  EXPECT_NE(run(exe + " --est b", &out), 0);
+  EXPECT_NE(runCommand(exe + " --est b", &out), 0);
   EXPECT_NE(out.find("--gt"), std::string::npos) << out;
 }

@@ -51,17 +51,9 @@ const bool kNoDisplay = [] {
   return true;
 }();
 
+// Headless, as on a robot or in CI.
 int run(const std::string& cmd, std::string* out) {
-  FILE* pipe = popen(("env -u DISPLAY " + cmd + " 2>&1").c_str(), "r");
-  char buf[4096];
-  out->clear();
-  while (fgets(buf, sizeof(buf), pipe)) *out += buf;
-  return WEXITSTATUS(pclose(pipe));
-}
-
-std::string readText(const std::string& path) {
-  std::ifstream in(path);
-  return std::string(std::istreambuf_iterator<char>(in), {});
+  return test::runCommand("env -u DISPLAY " + cmd, out);
 }
 
 std::size_t countOccurrences(const std::string& text, const std::string& what) {
@@ -407,7 +399,7 @@ TEST(RunLogger, TextLogHasLevelsAndTeesCoreMessagesOnlyDuringTheRun) {
   EXPECT_FALSE(logSink()) << "the previous (stderr) sink must be back";
   logWarn("probe after the run");
 
-  const std::string text = readText(dir + "/alvio.log");
+  const std::string text = test::readFile(dir + "/alvio.log");
   EXPECT_NE(text.find("[WARN ] probe warning 42"), std::string::npos) << text;
   EXPECT_EQ(text.find("probe info"), std::string::npos) << text;
   EXPECT_EQ(text.find("probe after"), std::string::npos) << text;
@@ -486,7 +478,7 @@ TEST(RunLogger, OfflineRunLogsEverythingConsistentlyWithTheRunOutputs) {
   // Periodic snapshots over the ~10 s of data, and the final one.
   EXPECT_GE(logger.logger()->counts().scenes, std::floor(9.0 / lo.scene_period_s) + 1);
 
-  const std::string text = readText(dir + "/alvio.log");
+  const std::string text = test::readFile(dir + "/alvio.log");
   EXPECT_NE(text.find("dataset: EuRoC folder"), std::string::npos);
   EXPECT_NE(text.find("initialised at"), std::string::npos) << text;
   EXPECT_GE(countOccurrences(text, " fps wall, "), 8u) << text;

@@ -5,9 +5,7 @@
 // normalised by, or selection silently drops the wrong features.
 #include <gtest/gtest.h>
 
-#include <sys/wait.h>
 #include <algorithm>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -25,29 +23,16 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string readText(const std::string& path) {
-  std::ifstream in(path);
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
-
-int run(const std::string& cmd, std::string* out) {
-  FILE* pipe = popen((cmd + " 2>&1").c_str(), "r");
-  if (!pipe) return -1;
-  char buf[4096];
-  while (fgets(buf, sizeof buf, pipe)) *out += buf;
-  const int status = pclose(pipe);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
 bool pythonWithNumpy() {
   std::string out;
-  return run("/usr/bin/python3 -c 'import numpy, matplotlib, yaml'", &out) == 0;
+  return test::runCommand("/usr/bin/python3 -c 'import numpy, matplotlib, yaml'", &out) == 0;
 }
 
 std::string analyze(const std::string& args, int* rc) {
   std::string out;
-  *rc = run("/usr/bin/python3 '" + test::sourcePath("scripts/analyze_sensitivity.py") + "' " + args,
-            &out);
+  *rc = test::runCommand(
+      "/usr/bin/python3 '" + test::sourcePath("scripts/analyze_sensitivity.py") + "' " + args,
+      &out);
   return out;
 }
 
@@ -113,9 +98,9 @@ TEST(SensitivityAnalysis, WriterRecordsTheImageSizeBesideTheCsvFiles) {
   const YamlReader size(dir + "/image_size.yaml");
   EXPECT_EQ(size.getInt("width"), 640);
   EXPECT_EQ(size.getInt("height"), 360);
-  EXPECT_EQ(readText(dir + "/points.csv"), "window_t,id,x_px,y_px,tracked_frames\n");
-  EXPECT_EQ(readText(dir + "/lines.csv"), "window_t,id,x_px,y_px,tracked_frames\n");
-  EXPECT_EQ(readText(dir + "/windows.csv").substr(0, 17), "window_t,frames,m");
+  EXPECT_EQ(test::readFile(dir + "/points.csv"), "window_t,id,x_px,y_px,tracked_frames\n");
+  EXPECT_EQ(test::readFile(dir + "/lines.csv"), "window_t,id,x_px,y_px,tracked_frames\n");
+  EXPECT_EQ(test::readFile(dir + "/windows.csv").substr(0, 17), "window_t,frames,m");
 }
 
 TEST(SensitivityAnalysis, AnalyzedSurfacesEvaluateInTheEstimatorAsFitted) {
@@ -182,7 +167,7 @@ TEST(SensitivityAnalysis, ConfigRefusesSurfacesFittedOnAnotherImageSize) {
   std::ofstream(dir + "/surfaces.yaml") << "width: 640\nheight: 360\ndegree: 1\n"
                                         << "points:\n  min_expected_track: 5\n"
                                         << "  coefficients: [6, 1, -2]\n";
-  std::string text = readText(test::sourcePath("config/euroc.yaml"));
+  std::string text = test::readFile(test::sourcePath("config/euroc.yaml"));
   const std::string from = "surfaces_file: \"\"";
   ASSERT_NE(text.find(from), std::string::npos) << "config/euroc.yaml changed";
   text.replace(text.find(from), from.size(), "surfaces_file: surfaces.yaml");

@@ -17,12 +17,7 @@ namespace fs = std::filesystem;
 namespace {
 
 int run(const std::string& args, std::string* out) {
-  const std::string cmd = std::string(ALVIO_BIN_DIR) + "/alvio_sim " + args + " 2>&1";
-  FILE* pipe = popen(cmd.c_str(), "r");
-  char buf[4096];
-  out->clear();
-  while (fgets(buf, sizeof(buf), pipe)) *out += buf;
-  return WEXITSTATUS(pclose(pipe));
+  return test::runCommand(std::string(ALVIO_BIN_DIR) + "/alvio_sim " + args, out);
 }
 
 std::string readBytes(const fs::path& p) {
