@@ -250,7 +250,8 @@ class RepeatsTest(unittest.TestCase):
         self.tmp.cleanup()
 
     def test_perturbation_steps_alternate_around_the_configured_value(self):
-        (self.dir / "base.yaml").write_text("estimator:\n  point_sigma_px: 2.0\n  window_size: 10\n")
+        (self.dir / "base.yaml").write_text(
+            "estimator:\n  point_sigma_px: 2.0\n  window_size: 10\n")
         (self.dir / "real.yaml").write_text("base: base.yaml\nestimator:\n  window_size: 8\n")
         args = ["--no-lines", "--config", str(self.dir / "real.yaml")]
         key = "estimator.point_sigma_px"

@@ -115,19 +115,19 @@ class PlotEvalTest(PlotTestCase):
     def test_empty_csv(self):
         write_csv(self.dir / "ate_pairs.csv", self.HEADER, [])
         self.assertFailsCleanly(run_script("plot_eval.py", self.dir),
-                         f"{self.dir / 'ate_pairs.csv'}: no rows")
+                                f"{self.dir / 'ate_pairs.csv'}: no rows")
         self.assertFalse((self.dir / "trajectory_top.png").exists())
 
     def test_missing_csv(self):
         (self.dir / "ate_pairs.csv").unlink()
         self.assertFailsCleanly(run_script("plot_eval.py", self.dir),
-                         f"{self.dir / 'ate_pairs.csv'}: No such file or directory")
+                                f"{self.dir / 'ate_pairs.csv'}: No such file or directory")
 
     def test_missing_column(self):
         header = [k for k in self.HEADER if k != "error_m"]
         write_csv(self.dir / "ate_pairs.csv", header, [[1.0] * len(header)] * 3)
         self.assertFailsCleanly(run_script("plot_eval.py", self.dir),
-                         f"{self.dir / 'ate_pairs.csv'}: no column error_m")
+                                f"{self.dir / 'ate_pairs.csv'}: no column error_m")
         self.assertFalse((self.dir / "trajectory_top.png").exists())
 
     def test_usage(self):
@@ -189,20 +189,20 @@ class PlotWeightsTest(PlotTestCase):
     def test_missing_frame_stats(self):
         (self.run_dir / "frame_stats.csv").unlink()
         self.assertFailsCleanly(run_script("plot_weights.py", self.run_dir),
-                         f"{self.run_dir / 'frame_stats.csv'} does not exist")
+                                f"{self.run_dir / 'frame_stats.csv'} does not exist")
 
     def test_missing_column(self):
         header = [k for k in self.HEADER if k != "w_p"]
         write_csv(self.run_dir / "frame_stats.csv", header, [[1] * len(header)] * 3)
         self.assertFailsCleanly(run_script("plot_weights.py", self.run_dir),
-                         f"{self.run_dir / 'frame_stats.csv'} has no column w_p")
+                                f"{self.run_dir / 'frame_stats.csv'} has no column w_p")
         self.assertFalse((self.run_dir / "weights.png").exists())
 
     def test_no_optimised_frames(self):
         write_csv(self.run_dir / "frame_stats.csv", self.HEADER,
                   [[f"{100 + k:.6f}", 1, 1, 0, 0, "0", "0", "0"] for k in range(3)])
         self.assertFailsCleanly(run_script("plot_weights.py", self.run_dir),
-                         f"no optimised frames in {self.run_dir / 'frame_stats.csv'}")
+                                f"no optimised frames in {self.run_dir / 'frame_stats.csv'}")
         self.assertFalse((self.run_dir / "weights.png").exists())
 
 
@@ -303,7 +303,8 @@ class PlotMapTruthTest(PlotTestCase):
         empty = self.dir / "empty.csv"
         empty.write_text("")
         p = run_script("plot_map_truth.py", empty, "--out", self.dir / "x.png")
-        self.assertFailsCleanly(p, f"{empty} has no endpoint or precision_with_texture_edges columns")
+        self.assertFailsCleanly(
+            p, f"{empty} has no endpoint or precision_with_texture_edges columns")
         self.assertFalse((self.dir / "x.png").exists())
 
     def test_missing_per_line_file(self):

@@ -9,7 +9,6 @@
 #include <filesystem>
 #include <fstream>
 #include <random>
-#include <sstream>
 
 #include "alvio/config/config.h"
 #include "alvio/config/yaml_reader.h"
