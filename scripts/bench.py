@@ -178,6 +178,26 @@ def config_value(path, key, depth=0):
     sys.exit(f"alvio bench: error: --perturb key '{key}' is not in {path}")
 
 
+def split_assignments(text):
+    """`--set` assignments split at the commas between them, not inside [...] or quotes
+    (as alvio run reads them: camera.resolution=[640,480] is one assignment)."""
+    parts, depth, quote, start = [], 0, None, 0
+    for i, c in enumerate(text):
+        if quote:
+            quote = None if c == quote else quote
+        elif c in "'\"":
+            quote = c
+        elif c in "[{":
+            depth += 1
+        elif c in "]}":
+            depth -= 1
+        elif c == "," and depth == 0:
+            parts.append(text[start:i])
+            start = i + 1
+    parts.append(text[start:])
+    return parts
+
+
 def perturbed_args(args, key, step, repeat):
     """The run's arguments with `key` scaled for the repeat-th run (none for the first)."""
     if repeat == 0:
@@ -185,7 +205,7 @@ def perturbed_args(args, key, step, repeat):
     base = None
     for i, a in enumerate(args[:-1]):  # the variant's own --set of the key wins over the file
         if a == "--set":
-            for assignment in args[i + 1].split(","):
+            for assignment in split_assignments(args[i + 1]):
                 if assignment.startswith(key + "="):
                     base = assignment.split("=", 1)[1]
     if base is None:
@@ -221,6 +241,8 @@ def aggregate(results):
                 continue
             vals = [r[k] for r in runs if isinstance(r.get(k), (int, float))]
             a[k] = statistics.median(vals) if len(vals) == len(runs) else None
+        # A repeat without timing leaves the medians undefined: none, not the first run's.
+        a["timing"] = None
         if all(r.get("timing") for r in runs):
             a["timing"] = {st: {q: statistics.median(r["timing"][st][q] for r in runs)
                                 for q in runs[0]["timing"][st]}

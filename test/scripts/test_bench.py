@@ -265,6 +265,12 @@ class RepeatsTest(unittest.TestCase):
         # A variant that sets the key itself is nudged around its own value.
         own = ["--set", "a.b=1," + key + "=3.0", "--config", str(self.dir / "real.yaml")]
         self.assertEqual(bench.perturbed_args(own, key, 1e-3, 2)[-1], key + "=2.997")
+        # A list value in the same --set is one assignment, not split at its comma.
+        listed = ["--set", "camera.resolution=[640,480]," + key + "=4.0", "--config",
+                  str(self.dir / "real.yaml")]
+        self.assertEqual(bench.perturbed_args(listed, key, 1e-3, 1)[-1], key + "=4.004")
+        self.assertEqual(bench.split_assignments("a=[1,2],b='x,y',c=3"),
+                         ["a=[1,2]", "b='x,y'", "c=3"])
         with self.assertRaises(SystemExit) as cm:
             bench.perturbed_args(args, "estimator.nowhere", 1e-3, 1)
         self.assertIn("estimator.nowhere", str(cm.exception.code))
@@ -291,6 +297,10 @@ class RepeatsTest(unittest.TestCase):
         (a,) = bench.aggregate(runs)
         self.assertIsNone(a["ate"])
         self.assertEqual(a["rc"], 3)
+        # A repeat without timing leaves no median times, not the first run's.
+        runs[1] = dict(runs[1], timing=None)
+        (a,) = bench.aggregate(runs)
+        self.assertIsNone(a["timing"])
 
 
 class MainTest(unittest.TestCase):
