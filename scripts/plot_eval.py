@@ -18,15 +18,18 @@ def main(out_dir):
     path = os.path.join(out_dir, "ate_pairs.csv")
     try:
         with open(path) as f:
-            rows = list(csv.DictReader(f))
+            reader = csv.DictReader(f)
+            missing = [k for k in COLUMNS if k not in (reader.fieldnames or COLUMNS)]
+            if missing:
+                sys.exit(f"{path}: no column {', '.join(missing)}")
+            rows = [[float(r[k]) for k in COLUMNS] for r in reader]
     except OSError as e:
         sys.exit(f"{path}: {e.strerror}")
+    except (TypeError, ValueError) as e:  # TypeError: a short row
+        sys.exit(f"{path} line {reader.line_num}: not a number ({e})")
     if not rows:
         sys.exit(f"{path}: no rows")
-    missing = [k for k in COLUMNS if k not in rows[0]]
-    if missing:
-        sys.exit(f"{path}: no column {', '.join(missing)}")
-    col = {k: [float(r[k]) for r in rows] for k in COLUMNS}
+    col = {k: [r[i] for r in rows] for i, k in enumerate(COLUMNS)}
     t0 = col["t"][0]
     t = [x - t0 for x in col["t"]]
 

@@ -22,6 +22,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.collections import LineCollection  # noqa: E402
 
 ENDPOINTS = ["x0", "y0", "x1", "y1"]
+NUMBERS = ENDPOINTS + ["precision_with_texture_edges", "length_m"]  # the columns plotted
 
 
 def read_lines(path):
@@ -29,18 +30,19 @@ def read_lines(path):
         with open(path) as f:
             reader = csv.DictReader(f)
             columns = reader.fieldnames or []  # none in an empty file
-            rows = list(reader)
+            missing = [k for k in ENDPOINTS + ["precision_with_texture_edges"] if k not in columns]
+            if missing:
+                sys.exit(f"plot_map_truth: {path} has no endpoint or precision_with_texture_edges "
+                         f"columns (no {', '.join(missing)}; write it with a current "
+                         "alvio_map_truth --per-line)")
+            if "length_m" not in columns:
+                sys.exit(f"plot_map_truth: {path} has no length_m column (write it with "
+                         "alvio_map_truth --per-line)")
+            return [{k: float(r[k]) for k in NUMBERS} for r in reader]
     except OSError as e:
         sys.exit(f"plot_map_truth: {path}: {e.strerror}")
-    missing = [k for k in ENDPOINTS + ["precision_with_texture_edges"] if k not in columns]
-    if missing:
-        sys.exit(f"plot_map_truth: {path} has no endpoint or precision_with_texture_edges "
-                 f"columns (no {', '.join(missing)}; write it with a current alvio_map_truth "
-                 "--per-line)")
-    if "length_m" not in columns:
-        sys.exit(f"plot_map_truth: {path} has no length_m column (write it with alvio_map_truth "
-                 "--per-line)")
-    return rows
+    except (TypeError, ValueError) as e:  # TypeError: a short row
+        sys.exit(f"plot_map_truth: {path} line {reader.line_num}: not a number ({e})")
 
 
 def read_scene_edges(sequence):
@@ -56,7 +58,10 @@ def read_scene_edges(sequence):
             if len(v) < 6:
                 sys.exit(f"plot_map_truth: {path} line {number} has {len(v)} columns, not "
                          "id,ax,ay,az,bx,by,...")
-            edges.append([(float(v[1]), float(v[2])), (float(v[4]), float(v[5]))])
+            try:
+                edges.append([(float(v[1]), float(v[2])), (float(v[4]), float(v[5]))])
+            except ValueError as e:
+                sys.exit(f"plot_map_truth: {path} line {number}: not a number ({e})")
     return edges
 
 
@@ -77,12 +82,12 @@ def main():
         rows = read_lines(path)
         if scene:
             ax.add_collection(LineCollection(scene, colors="0.8", linewidths=0.5))
-        segments = [[(float(r["x0"]), float(r["y0"])), (float(r["x1"]), float(r["y1"]))] for r in rows]
-        good = [float(r["precision_with_texture_edges"]) for r in rows]
+        segments = [[(r["x0"], r["y0"]), (r["x1"], r["y1"])] for r in rows]
+        good = [r["precision_with_texture_edges"] for r in rows]
         ax.add_collection(LineCollection(segments, colors=[(1 - g, 0.6 * g, 0) for g in good],
                                          linewidths=1.2))
-        length = sum(float(r["length_m"]) for r in rows)
-        on_edge = sum(float(r["length_m"]) * g for r, g in zip(rows, good))
+        length = sum(r["length_m"] for r in rows)
+        on_edge = sum(r["length_m"] * g for r, g in zip(rows, good))
         ax.set_title(f"{title}: {len(rows)} lines, {length:.0f} m, "
                      f"{100 * on_edge / max(length, 1e-9):.1f} % on a true edge")
         ax.set_aspect("equal")

@@ -33,24 +33,28 @@ def main():
         missing = [k for k in COLUMNS if k not in (reader.fieldnames or [])]
         if missing:
             sys.exit(f"plot-weights: {stats} has no column {', '.join(missing)}")
-        rows = [r for r in reader if float(r["w_p"] or 0) + float(r["w_l"] or 0) > 0]
+        try:  # frames before the first optimisation have empty weights
+            rows = [{k: float(r[k] or 0) for k in COLUMNS} for r in reader]
+        except (TypeError, ValueError) as e:  # TypeError: a short row
+            sys.exit(f"plot-weights: {stats} line {reader.line_num}: not a number ({e})")
+        rows = [r for r in rows if r["w_p"] + r["w_l"] > 0]
     if not rows:
         sys.exit(f"plot-weights: no optimised frames in {stats}")
-    t0 = float(rows[0]["t"])
-    t = [float(r["t"]) - t0 for r in rows]
+    t0 = rows[0]["t"]
+    t = [r["t"] - t0 for r in rows]
     fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(10, 6), sharex=True)
-    ax1.plot(t, [float(r["w_p"]) for r in rows], label="w_p (points)", lw=1)
-    ax1.plot(t, [float(r["w_l"]) for r in rows], label="w_l (lines)", lw=1)
+    ax1.plot(t, [r["w_p"] for r in rows], label="w_p (points)", lw=1)
+    ax1.plot(t, [r["w_l"] for r in rows], label="w_l (lines)", lw=1)
     ax1.set_ylabel("weight")
     ax1.set_ylim(0, 1)
     ax1b = ax1.twinx()
-    ax1b.plot(t, [float(r["alpha"]) for r in rows], color="grey", lw=0.6, alpha=0.6, label="alpha")
+    ax1b.plot(t, [r["alpha"] for r in rows], color="grey", lw=0.6, alpha=0.6, label="alpha")
     ax1b.set_ylabel("alpha")
     ax1.legend(loc="upper left")
     run = Path(a.run).resolve()
     ax1.set_title(f"adaptive point/line weights: {run.parent.name}/{run.name}")
-    ax2.plot(t, [float(r["points_used"]) for r in rows], label="points used", lw=1)
-    ax2.plot(t, [float(r["lines_used"]) for r in rows], label="lines used", lw=1)
+    ax2.plot(t, [r["points_used"] for r in rows], label="points used", lw=1)
+    ax2.plot(t, [r["lines_used"] for r in rows], label="lines used", lw=1)
     ax2.set_xlabel("time since initialisation [s]")
     ax2.set_ylabel("features per frame")
     ax2.legend(loc="upper left")

@@ -130,6 +130,14 @@ class PlotEvalTest(PlotTestCase):
                                 f"{self.dir / 'ate_pairs.csv'}: no column error_m")
         self.assertFalse((self.dir / "trajectory_top.png").exists())
 
+    def test_value_not_a_number(self):
+        rows = [[1.0] * len(self.HEADER) for _ in range(3)]
+        rows[1][1] = "nan?"
+        write_csv(self.dir / "ate_pairs.csv", self.HEADER, rows)
+        self.assertFailsCleanly(run_script("plot_eval.py", self.dir),
+                                f"{self.dir / 'ate_pairs.csv'} line 3: not a number", "nan?")
+        self.assertFalse((self.dir / "trajectory_top.png").exists())
+
     def test_usage(self):
         self.assertFailsCleanly(run_script("plot_eval.py"), "usage: plot_eval.py DIR")
 
@@ -196,6 +204,15 @@ class PlotWeightsTest(PlotTestCase):
         write_csv(self.run_dir / "frame_stats.csv", header, [[1] * len(header)] * 3)
         self.assertFailsCleanly(run_script("plot_weights.py", self.run_dir),
                                 f"{self.run_dir / 'frame_stats.csv'} has no column w_p")
+        self.assertFalse((self.run_dir / "weights.png").exists())
+
+    def test_value_not_a_number(self):
+        with open(self.run_dir / "frame_stats.csv", "a") as f:
+            f.write("100.5,150,40,90,20,0.5,0.5,x2\n")
+        n = len((self.run_dir / "frame_stats.csv").read_text().splitlines())
+        self.assertFailsCleanly(run_script("plot_weights.py", self.run_dir),
+                                f"{self.run_dir / 'frame_stats.csv'} line {n}: not a number",
+                                "x2")
         self.assertFalse((self.run_dir / "weights.png").exists())
 
     def test_no_optimised_frames(self):
@@ -298,6 +315,18 @@ class PlotMapTruthTest(PlotTestCase):
         p = run_script("plot_map_truth.py", short, "--out", self.dir / "x.png")
         self.assertFailsCleanly(p, f"{short} has no length_m column")
         self.assertFalse((self.dir / "x.png").exists())
+
+    def test_value_not_a_number(self):
+        bad = self.dir / "bad.csv"
+        bad.write_text(self.a.read_text().replace("\n2,", "\n2,?", 1))
+        p = run_script("plot_map_truth.py", bad, "--out", self.dir / "x.png")
+        self.assertFailsCleanly(p, f"{bad} line 4: not a number")
+        self.assertFalse((self.dir / "x.png").exists())
+        with open(self.sequence / "scene_edges.csv", "a") as f:
+            f.write("7,1.0,2.0,-2.4,y,1.0,-2.4,hall\n")
+        p = run_script("plot_map_truth.py", self.a, "--out", self.dir / "x.png",
+                       "--sequence", self.sequence)
+        self.assertFailsCleanly(p, f"{self.sequence / 'scene_edges.csv'} line 4: not a number")
 
     def test_empty_per_line_file(self):
         empty = self.dir / "empty.csv"
