@@ -1,10 +1,13 @@
 #include <gtest/gtest.h>
 
+#include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
 #include "alvio/common/error.h"
 #include "alvio/common/logging.h"
+#include "alvio/common/resource_path.h"
 #include "alvio/config/config.h"
 #include "alvio/config/yaml_reader.h"
 #include "alvio/io/euroc_dataset.h"
@@ -208,4 +211,26 @@ TEST(ConfigBase, ShippedRealImuConfigIsEurocWithInFlightImuNoise) {
   EXPECT_DOUBLE_EQ(real.imu.accelerometer_noise_density, euroc.imu.accelerometer_noise_density);
   EXPECT_EQ(real.estimator.window_size, euroc.estimator.window_size);
   EXPECT_DOUBLE_EQ(euroc.estimator.imu_noise.accelerometer_noise_density, 0.0);
+}
+
+TEST(PackageFiles, AnInstalledProgramReadsItsInstalledConfigNotTheSourceTree) {
+  namespace fs = std::filesystem;
+  const fs::path prefix = test::scratchDir();
+  const char* root = std::getenv("ALVIO_ROOT");  // it would come first
+  const std::string saved_root = root ? root : "";
+  unsetenv("ALVIO_ROOT");
+  fs::create_directories(prefix / "share/alvio/config");
+  fs::create_directories(prefix / "lib/alvio");
+  const std::string installed =
+      writeFile((prefix / "share/alvio/config").string(), "euroc.yaml", "installed: true\n");
+  const std::string exe = (prefix / "lib/alvio/alvio_run").string();
+  EXPECT_EQ(findPackageFile("config/euroc.yaml", exe), installed);
+  // A file the install lacks comes from the source tree, as for a devel-space program.
+  EXPECT_EQ(fs::canonical(findPackageFile("config/euroc_real.yaml", exe)),
+            fs::canonical(test::sourcePath("config/euroc_real.yaml")));
+  EXPECT_EQ(fs::canonical(findPackageFile("config/euroc.yaml", "/nowhere/lib/alvio/alvio_run")),
+            fs::canonical(test::sourcePath("config/euroc.yaml")));
+  EXPECT_NE(test::errorOf([&] { findPackageFile("config/none.yaml", exe); }).find("none.yaml"),
+            std::string::npos);
+  if (!saved_root.empty()) setenv("ALVIO_ROOT", saved_root.c_str(), 1);
 }

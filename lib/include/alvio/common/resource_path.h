@@ -6,8 +6,12 @@
 
 namespace alvio {
 
-/// Path of `relative` (e.g. "config/euroc.yaml") under $ALVIO_ROOT, the source tree
-/// this library was built from, or the installed share/alvio. Throws alvio::Error if absent.
+/// Path of `relative` (e.g. "config/euroc.yaml"): under $ALVIO_ROOT if set, else in the
+/// installed package of the running program (<prefix>/share/alvio, when it has the file),
+/// else in the source tree this library was built from. Throws alvio::Error if absent.
 std::string findPackageFile(const std::string& relative);
+
+/// The same, for a program at `executable` (findPackageFile passes /proc/self/exe).
+std::string findPackageFile(const std::string& relative, const std::string& executable);
 
 }  // namespace alvio
