@@ -66,9 +66,9 @@ struct EstimatorOptions {
   double init_settle_max_s = 1.5;  ///< ...or for this long at most. 0: output at once.
 
   // Failure detection (reset and re-initialise).
-  int min_tracked_features = 10;  ///< fewer points + lines tracked into a frame: reset
-  double max_accel_bias = 2.5;    ///< m/s^2
-  double max_gyro_bias = 1.0;     ///< rad/s
+  int min_tracked_features = 3;  ///< fewer points + lines tracked into a frame: reset
+  double max_accel_bias = 2.5;   ///< m/s^2
+  double max_gyro_bias = 1.0;    ///< rad/s
   double max_translation_jump_m = 5.0;
   double max_z_jump_m = 1.0;
   double max_rotation_jump_deg = 50.0;
