@@ -54,6 +54,14 @@ std::vector<BenchmarkSequence> standardBenchmarkSet(const SequenceOptions& base)
         o.camera.exposure_time_s = 0.008;
         o.camera.motion_blur_samples = 3;
       });
+  // Where points are scarce and lines are not: plain walls, long straight edges, and a
+  // turn on the spot in front of a wall at the far end.
+  add("sim_corridor_lowtex", "corridor walk there and back (30 s), poor texture, synthetic IMU",
+      [](SequenceOptions& o) {
+        o.scene = "corridor";
+        o.trajectory = "corridor";
+        o.texture = "poor";
+      });
   return set;
 }
 
