@@ -4,11 +4,18 @@
 # its launch files. A python3 without Debian's ROS modules comes first on PATH, as with
 # pyenv or conda; the README's -DPYTHON_EXECUTABLE=/usr/bin/python3 must be enough.
 #
-#   test/packaging/catkin_workspace.sh SOURCE_DIR SCRATCH_DIR
+#   test/packaging/catkin_workspace.sh SOURCE_DIR LOG_DIR
+#
+# The workspace lives in a temporary folder outside the source tree and is removed at the
+# end: its src/alvio links back to the source, and inside the tree (as under build/) that
+# link made roslaunch find every launch file twice, so `./alvio demo` failed after the tests.
 set -euo pipefail
 src="$(cd "$1" && pwd)"
-ws="$2"
-rm -rf "$ws"
+logs="$2"
+rm -rf "$logs"
+mkdir -p "$logs"
+ws="$(mktemp -d "${TMPDIR:-/tmp}/alvio_catkin_ws.XXXXXX")"
+trap 'cp -f "$ws/catkin_make.log" "$logs/" 2>/dev/null; rm -rf "$ws"' EXIT
 mkdir -p "$ws/src" "$ws/fake-bin"
 ln -s "$src" "$ws/src/alvio"
 
@@ -31,7 +38,7 @@ unset PYTHONPATH AMENT_PREFIX_PATH CMAKE_PREFIX_PATH ROS_PACKAGE_PATH || true
 if ! catkin_make -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCATKIN_ENABLE_TESTING=OFF \
   alvio_generate_messages_cpp >"$ws/catkin_make.log" 2>&1; then
   tail -30 "$ws/catkin_make.log" >&2
-  echo "catkin_workspace: catkin_make failed (log: $ws/catkin_make.log)" >&2
+  echo "catkin_workspace: catkin_make failed (log: $logs/catkin_make.log)" >&2
   exit 1
 fi
 [[ -f devel/include/alvio/PipelineStatus.h ]] || { echo "no generated PipelineStatus.h" >&2; exit 1; }
@@ -46,4 +53,7 @@ rospack plugins --attrib=plugin nodelet | grep -q "^alvio " ||
   { echo "alvio's nodelet plugins are not exported" >&2; exit 1; }
 [[ -f "$(rospack find alvio)/launch/alvio.launch" ]] ||
   { echo "launch/alvio.launch not found through rospack" >&2; exit 1; }
+# roslaunch looks a launch file up by walking the whole package folder: one hit, or it stops.
+hits="$(/usr/bin/python3 -c 'import roslib.packages as p; print(len(p.find_resource("alvio", "sim.launch")))')"
+[[ "$hits" == 1 ]] || { echo "roslaunch would find sim.launch $hits times in alvio" >&2; exit 1; }
 echo "catkin_workspace: configured, messages generated, package and nodelet plugins found"
