@@ -35,6 +35,7 @@ int main(int argc, char** argv) {
   args.flag("no-lines", "points only (no line front end, no line landmarks)");
   args.option("line-tracker", "flow (ALVIO optical flow) | descriptor (PL-VIO LBD baseline)");
   args.flag("quiet", "no progress bar");
+  args.flag("verbose", "debug messages on stderr (why initialisation waits, solver details)");
   args.option("analysis", "write sensitivity-analysis records (CSV) into this folder");
   args.listOption("set",
                   "override configuration keys: key=value[,key=value...], may be repeated "
@@ -42,6 +43,7 @@ int main(int argc, char** argv) {
   args.flag("no-log", "no MRPT logs (rawlog, 3D scene, alvio.log); also config logger.enabled");
   try {
     if (!args.parse(argc, argv)) return 0;
+    if (args.isSet("verbose")) setLogLevel(LogLevel::kDebug);
     // The configuration file with the --set overrides laid over it; the reader keeps the
     // file's path, so relative paths in it still resolve next to the file.
     const std::string config_path = args.get("config");
