@@ -53,7 +53,8 @@ VARIANTS = {
 ABLATION = [("no selection", "sel-none"), ("line selection", "sel-lines"),
             ("point selection", "sel-points"), ("both", "sel-both")]
 DEFAULT_SEQUENCES = ["sim_MH_01", "sim_MH_02", "sim_MH_03", "sim_MH_05", "sim_MH_03_realimu",
-                     "sim_MH_05_realimu", "sim_MH_05_lowtex", "sim_MH_05_dim", "sim_corridor_lowtex"]
+                     "sim_MH_05_realimu", "sim_MH_05_lowtex", "sim_MH_05_dim",
+                     "sim_corridor_lowtex"]
 
 
 def log(msg):

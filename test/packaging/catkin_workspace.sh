@@ -8,7 +8,8 @@
 #
 # The workspace lives in a temporary folder outside the source tree and is removed at the
 # end: its src/alvio links back to the source, and inside the tree (as under build/) that
-# link made roslaunch find every launch file twice, so `./alvio demo` failed after the tests.
+# link made roslaunch find every launch file many times, so `./alvio demo` failed after the
+# tests.
 set -euo pipefail
 src="$(cd "$1" && pwd)"
 logs="$2"
