@@ -55,6 +55,7 @@ rospack plugins --attrib=plugin nodelet | grep -q "^alvio " ||
 [[ -f "$(rospack find alvio)/launch/alvio.launch" ]] ||
   { echo "launch/alvio.launch not found through rospack" >&2; exit 1; }
 # roslaunch looks a launch file up by walking the whole package folder: one hit, or it stops.
-hits="$(/usr/bin/python3 -c 'import roslib.packages as p; print(len(p.find_resource("alvio", "sim.launch")))')"
+hits="$(/usr/bin/python3 -c \
+  'import roslib.packages as p; print(len(p.find_resource("alvio", "sim.launch")))')"
 [[ "$hits" == 1 ]] || { echo "roslaunch would find sim.launch $hits times in alvio" >&2; exit 1; }
 echo "catkin_workspace: configured, messages generated, package and nodelet plugins found"
