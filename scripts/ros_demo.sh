@@ -80,7 +80,7 @@ if $record_status; then
 fi
 log "playing $(basename "$bag") at rate $rate through the nodelet pipeline (master $ROS_MASTER_URI)"
 start=$(date +%s)
-roslaunch alvio sim.launch bag:="$bag" rate:="$rate" output_dir:="$run" logging:="$logging" \
+roslaunch "$ROOT/launch/sim.launch" bag:="$bag" rate:="$rate" output_dir:="$run" logging:="$logging" \
   exit_at_end:=false >"$out/roslaunch.log" 2>&1 &
 launch_pid=$!
 trap 'kill -INT "$launch_pid" ${record_pid:-} 2>/dev/null || true; kill "$core_pid" 2>/dev/null || true; wait 2>/dev/null || true' EXIT

@@ -43,7 +43,7 @@ trap 'kill $core_pid 2>/dev/null || true; wait 2>/dev/null || true' EXIT
 start_private_master "$out" || die "roscore did not start (see $out/roscore.log)"
 
 log "looping $(basename "$bag") at rate $rate for $minutes min (master $ROS_MASTER_URI)"
-roslaunch alvio sim.launch bag:="$bag" rate:="$rate" loop:=true output_dir:="$out/run" \
+roslaunch "$ROOT/launch/sim.launch" bag:="$bag" rate:="$rate" loop:=true output_dir:="$out/run" \
   exit_at_end:=false >"$out/roslaunch.log" 2>&1 &
 launch_pid=$!
 trap 'kill -INT "$launch_pid" 2>/dev/null || true; wait "$launch_pid" 2>/dev/null || true; kill "$core_pid" 2>/dev/null || true; wait 2>/dev/null || true' EXIT
