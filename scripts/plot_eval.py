@@ -19,6 +19,7 @@ def main(out_dir):
     try:
         with open(path) as f:
             reader = csv.DictReader(f)
+            # An empty file has no header: it ends below as "no rows".
             missing = [k for k in COLUMNS if k not in (reader.fieldnames or COLUMNS)]
             if missing:
                 sys.exit(f"{path}: no column {', '.join(missing)}")

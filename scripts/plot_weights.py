@@ -33,11 +33,13 @@ def main():
         missing = [k for k in COLUMNS if k not in (reader.fieldnames or [])]
         if missing:
             sys.exit(f"plot-weights: {stats} has no column {', '.join(missing)}")
-        try:  # frames before the first optimisation have empty weights
-            rows = [{k: float(r[k] or 0) for k in COLUMNS} for r in reader]
+        rows = []
+        try:
+            for r in reader:  # frames before the first optimisation have empty weights
+                if float(r["w_p"] or 0) + float(r["w_l"] or 0) > 0:
+                    rows.append({k: float(r[k]) for k in COLUMNS})
         except (TypeError, ValueError) as e:  # TypeError: a short row
             sys.exit(f"plot-weights: {stats} line {reader.line_num}: not a number ({e})")
-        rows = [r for r in rows if r["w_p"] + r["w_l"] > 0]
     if not rows:
         sys.exit(f"plot-weights: no optimised frames in {stats}")
     t0 = rows[0]["t"]

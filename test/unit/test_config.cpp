@@ -36,8 +36,7 @@ void expectErrorMentioning(F&& f, std::initializer_list<std::string> fragments) 
 }
 
 std::string eurocYaml() {
-  std::ifstream in(test::sourcePath("config/euroc.yaml"));
-  return std::string(std::istreambuf_iterator<char>(in), {});
+  return test::readFile(test::sourcePath("config/euroc.yaml"));
 }
 
 std::string eurocYamlWithout(const std::string& key) {

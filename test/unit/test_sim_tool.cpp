@@ -2,10 +2,8 @@
 // output for a seed, the real-IMU mode, rosbags and the benchmark cache.
 #include <gtest/gtest.h>
 
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 
 #include "alvio/io/euroc_dataset.h"
 #include "alvio/io/trajectory_io.h"
@@ -20,18 +18,12 @@ int run(const std::string& args, std::string* out) {
   return test::runCommand(std::string(ALVIO_BIN_DIR) + "/alvio_sim " + args, out);
 }
 
-std::string readBytes(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 // Every file under `dir` (relative path -> content).
 std::map<std::string, std::string> snapshot(const std::string& dir) {
   std::map<std::string, std::string> files;
   for (const auto& e : fs::recursive_directory_iterator(dir))
-    if (e.is_regular_file()) files[fs::relative(e.path(), dir).string()] = readBytes(e.path());
+    if (e.is_regular_file())
+      files[fs::relative(e.path(), dir).string()] = test::readFile(e.path().string());
   return files;
 }
 
@@ -105,7 +97,7 @@ TEST(SimTool, WritesARosbag) {
   const std::string dir = test::scratchDir() + "/bagged";
   std::string out;
   ASSERT_EQ(run(std::string(kSmall) + "--bag --out " + dir, &out), 0) << out;
-  const std::string bag = readBytes(dir + "/bagged.bag");
+  const std::string bag = test::readFile(dir + "/bagged.bag");
   ASSERT_GT(bag.size(), 13u * 752 * 480);  // the raw images alone
   EXPECT_EQ(bag.substr(0, 13), "#ROSBAG V2.0\n");
   EXPECT_NE(bag.find("/cam0/image_raw"), std::string::npos);
