@@ -99,3 +99,28 @@ TEST(StructureFromMotion, ConvergesWithNoiseAndPartialTracks) {
     EXPECT_LT((r.t_ref_c[k] - t_true).norm(), 0.02) << k;
   }
 }
+
+// A poorly textured scene: the frames between the reference and the last see only 12 points
+// (the low-texture corridor after a reset saw 11-14). Their poses still come out.
+TEST(StructureFromMotion, ReconstructsFromTwelvePointsPerFrame) {
+  const int n = 6;
+  const Scene s = makeScene(n);
+  const int ref = 0;
+  std::vector<SfmTrack> tracks;
+  for (int i = 0; i < 12; ++i) {
+    SfmTrack track;
+    track.id = i;
+    for (int k = 0; k < n; ++k) track.sightings.emplace_back(k, s.observe(k, i));
+    tracks.push_back(track);
+  }
+  const Eigen::Matrix3d R_ref_last = s.R[ref].transpose() * s.R[n - 1];
+  const Eigen::Vector3d t_ref_last = s.R[ref].transpose() * (s.t[n - 1] - s.t[ref]);
+  const double scale = 1.0 / t_ref_last.norm();
+  SfmResult r;
+  ASSERT_TRUE(reconstructStructure(n, ref, R_ref_last, t_ref_last * scale, tracks, &r));
+  for (int k = 0; k < n; ++k) {
+    const Eigen::Vector3d t_true = s.R[ref].transpose() * (s.t[k] - s.t[ref]) * scale;
+    EXPECT_LT((r.t_ref_c[k] - t_true).norm(), 1e-5) << k;
+  }
+  EXPECT_EQ(r.points.size(), 12u);
+}

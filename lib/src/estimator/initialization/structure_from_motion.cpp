@@ -13,6 +13,12 @@
 #include "alvio/common/logging.h"
 
 namespace alvio {
+namespace {
+// A frame's pose is solved from this many triangulated points at the least. 15 stopped the
+// low-texture corridor from initialising again after a reset (11-14 points seen); 10 is
+// VINS-Mono's hard limit too.
+constexpr std::size_t kMinPnpPoints = 10;
+}  // namespace
 
 bool relativePoseFromEssential(const std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>>& corr,
                                Eigen::Matrix3d* R_a_b, Eigen::Vector3d* t_a_b) {
@@ -87,7 +93,7 @@ struct ReprojectionError {
 bool cameraPoseFromPoints(const std::vector<Eigen::Vector3d>& points,
                           const std::vector<Eigen::Vector2d>& observations,
                           Eigen::Matrix3d* R_ref_c, Eigen::Vector3d* t_ref_c) {
-  if (points.size() < 10) return false;
+  if (points.size() < kMinPnpPoints) return false;
   std::vector<cv::Point3f> obj;
   std::vector<cv::Point2f> img;
   for (std::size_t i = 0; i < points.size(); ++i) {
@@ -151,7 +157,7 @@ bool reconstructStructure(int num_frames, int ref, const Eigen::Matrix3d& R_ref_
         obs.push_back(x);
       }
     }
-    if (pts.size() < 15) {
+    if (pts.size() < kMinPnpPoints) {
       logDebug("sfm: frame ", frame, " sees only ", pts.size(), " triangulated points");
       return false;
     }
