@@ -23,6 +23,8 @@ std::string errorOf(const std::function<void()>& f);
 int runCommand(const std::string& command, std::string* out);
 /// A file's bytes ("" when it cannot be read).
 std::string readFile(const std::string& path);
+/// Write text to path (binary) and return the path.
+std::string writeFile(const std::string& path, const std::string& text);
 
 }  // namespace alvio::test
 

@@ -3,7 +3,6 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -24,11 +23,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string writeFile(const std::string& path, const std::string& text) {
-  std::ofstream(path, std::ios::binary) << text;
-  return path;
-}
-
 #define EXPECT_MENTIONS(message, fragment)               \
   EXPECT_NE((message).find(fragment), std::string::npos) \
       << "'" << (message) << "' lacks '" << (fragment) << "'"
@@ -40,7 +34,7 @@ std::string configReplacing(const std::string& dir, const std::string& from,
   const auto pos = text.find(from);
   EXPECT_NE(pos, std::string::npos) << from;
   if (pos != std::string::npos) text.replace(pos, from.size(), to);
-  return writeFile(dir + "/config.yaml", text);
+  return test::writeFile(dir + "/config.yaml", text);
 }
 
 // A small EuRoC folder: `count` textured images of width x height at 20 Hz and a still,
@@ -162,19 +156,19 @@ TEST(BadDataset, MissingFolderIsNamed) {
 
 TEST(BadDataset, CsvWithBadLineNamesFileAndLine) {
   const std::string dir = test::scratchDir();
-  const std::string csv = writeFile(dir + "/imu.csv",
-                                    "#timestamp [ns],wx,wy,wz,ax,ay,az\n"
-                                    "1000,0,0,0,0,0,9.81\n"
-                                    "2000,0,0,zero,0,0,9.81\n");
+  const std::string csv = test::writeFile(dir + "/imu.csv",
+                                          "#timestamp [ns],wx,wy,wz,ax,ay,az\n"
+                                          "1000,0,0,0,0,0,9.81\n"
+                                          "2000,0,0,zero,0,0,9.81\n");
   std::string msg = errorOf([&] { readEurocImuCsv(csv); });
   EXPECT_MENTIONS(msg, csv + ":3");
   EXPECT_MENTIONS(msg, "'zero'");
   // A line cut short (as by a full disk) is named the same way.
-  writeFile(csv, "1000,0,0,0,0,0,9.81\n2000,0,0\n");
+  test::writeFile(csv, "1000,0,0,0,0,0,9.81\n2000,0,0\n");
   msg = errorOf([&] { readEurocImuCsv(csv); });
   EXPECT_MENTIONS(msg, csv + ":2");
   EXPECT_MENTIONS(msg, "7 columns");
-  writeFile(dir + "/cam.csv", "#t,file\n1000,a.png\nnot-a-stamp,b.png\n");
+  test::writeFile(dir + "/cam.csv", "#t,file\n1000,a.png\nnot-a-stamp,b.png\n");
   msg = errorOf([&] { readEurocImageCsv(dir + "/cam.csv", dir); });
   EXPECT_MENTIONS(msg, "cam.csv:3");
   EXPECT_MENTIONS(msg, "not-a-stamp");
@@ -183,12 +177,12 @@ TEST(BadDataset, CsvWithBadLineNamesFileAndLine) {
 // Rounding a fractional stamp at the int64 limit overflowed (UBSan in fuzz_euroc_csv).
 TEST(BadDataset, StampAtTheInt64LimitIsAnErrorNotAnOverflow) {
   const std::string dir = test::scratchDir();
-  const std::string csv = writeFile(dir + "/cam.csv", "9223372036854775807.9,a.png\n");
+  const std::string csv = test::writeFile(dir + "/cam.csv", "9223372036854775807.9,a.png\n");
   const std::string msg = errorOf([&] { readEurocImageCsv(csv, dir); });
   EXPECT_MENTIONS(msg, csv + ":1");
   EXPECT_MENTIONS(msg, "not an integer");
   // Fractional stamps round half away from zero, also below zero.
-  writeFile(csv, "-0.7,a.png\n1.5,b.png\n");
+  test::writeFile(csv, "-0.7,a.png\n1.5,b.png\n");
   const auto records = readEurocImageCsv(csv, dir);
   ASSERT_EQ(records.size(), 2u);
   EXPECT_EQ(records[0].t_ns, -1);
@@ -198,8 +192,9 @@ TEST(BadDataset, StampAtTheInt64LimitIsAnErrorNotAnOverflow) {
 // Found by fuzz_tum_trajectory: a stamp beyond the int64 ns range wrapped and an
 // out-of-order file was accepted by the strict reader.
 TEST(BadDataset, TumStampBeyondNanosecondRangeIsAnError) {
-  const std::string tum = writeFile(test::scratchDir() + "/traj.txt",
-                                    "14037152575.3 0 0 0 0 0 0 1\n1403715274.3 0 0 0 0 0 0 1\n");
+  const std::string tum =
+      test::writeFile(test::scratchDir() + "/traj.txt",
+                      "14037152575.3 0 0 0 0 0 0 1\n1403715274.3 0 0 0 0 0 0 1\n");
   const std::string msg = errorOf([&] { readTrajectory(tum, TrajectoryFormat::kTum); });
   EXPECT_MENTIONS(msg, tum + ":1");
   EXPECT_MENTIONS(msg, "14037152575.3");
@@ -215,7 +210,7 @@ TEST(BadDataset, TruncatedPngIsSkippedAndCounted) {
   ASSERT_EQ(pngs.size(), 5u);
   fs::resize_file(pngs[2], fs::file_size(pngs[2]) / 2);
   // And make the fourth not a PNG at all.
-  writeFile(pngs[3].string(), "this is not an image");
+  test::writeFile(pngs[3].string(), "this is not an image");
 
   EurocSource source(data);
   const RunResult r = runOffline(source, defaultConfig(), quietRun(dir + "/out"));

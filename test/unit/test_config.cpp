@@ -2,7 +2,6 @@
 
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <sstream>
 
 #include "alvio/common/error.h"
@@ -16,12 +15,6 @@
 using namespace alvio;
 
 namespace {
-std::string writeFile(const std::string& dir, const std::string& name, const std::string& text) {
-  const std::string path = dir + "/" + name;
-  std::ofstream(path) << text;
-  return path;
-}
-
 // Expect an alvio::Error whose message contains every fragment.
 template <typename F>
 void expectErrorMentioning(F&& f, std::initializer_list<std::string> fragments) {
@@ -70,32 +63,33 @@ TEST(Config, DefaultEurocConfigLoadsWithEurocValues) {
 
 TEST(Config, MissingKeyNamesFileAndKey) {
   const std::string dir = test::scratchDir();
-  const std::string path = writeFile(dir, "bad.yaml", eurocYamlWithout("gyroscope_random_walk"));
+  const std::string path =
+      test::writeFile(dir + "/bad.yaml", eurocYamlWithout("gyroscope_random_walk"));
   expectErrorMentioning([&] { Config::load(path); },
                         {path, "imu.gyroscope_random_walk", "missing"});
 }
 
 TEST(Config, MalformedValueNamesKeyAndValue) {
   const std::string dir = test::scratchDir();
-  const std::string path = writeFile(
-      dir, "bad.yaml",
+  const std::string path = test::writeFile(
+      dir + "/bad.yaml",
       eurocYamlReplacing("gyroscope_noise_density: 1.6968e-04", "gyroscope_noise_density: fast"));
   expectErrorMentioning([&] { Config::load(path); }, {"imu.gyroscope_noise_density", "fast"});
 }
 
 TEST(Config, NegativeNoiseIsRejected) {
   const std::string dir = test::scratchDir();
-  const std::string path = writeFile(dir, "neg.yaml",
-                                     eurocYamlReplacing("accelerometer_random_walk: 3.0000e-3",
-                                                        "accelerometer_random_walk: -3e-3"));
+  const std::string path =
+      test::writeFile(dir + "/neg.yaml", eurocYamlReplacing("accelerometer_random_walk: 3.0000e-3",
+                                                            "accelerometer_random_walk: -3e-3"));
   expectErrorMentioning([&] { Config::load(path); }, {"accelerometer_random_walk", "positive"});
 }
 
 TEST(Config, NegativeSettlingIsRejected) {
   const std::string dir = test::scratchDir();
   const std::string path =
-      writeFile(dir, "settle.yaml",
-                eurocYamlReplacing("init_settle_change: 0.003", "init_settle_change: -1"));
+      test::writeFile(dir + "/settle.yaml",
+                      eurocYamlReplacing("init_settle_change: 0.003", "init_settle_change: -1"));
   expectErrorMentioning([&] { Config::load(path); },
                         {"estimator.init_settle_change", "must not be negative"});
 }
@@ -105,9 +99,9 @@ TEST(Config, LineMapFilterIsReadAndANegativeParallaxIsRejected) {
   EXPECT_DOUBLE_EQ(c.estimator.line_map_max_rms_px, 0.5);
   EXPECT_DOUBLE_EQ(c.estimator.line_map_min_parallax, 0.10);
   const std::string dir = test::scratchDir();
-  const std::string path =
-      writeFile(dir, "parallax.yaml",
-                eurocYamlReplacing("line_map_min_parallax: 0.10", "line_map_min_parallax: -0.1"));
+  const std::string path = test::writeFile(
+      dir + "/parallax.yaml",
+      eurocYamlReplacing("line_map_min_parallax: 0.10", "line_map_min_parallax: -0.1"));
   expectErrorMentioning([&] { Config::load(path); },
                         {"estimator.line_map_min_parallax", "must not be negative"});
 }
@@ -117,15 +111,16 @@ TEST(Config, SolverIterationsAreReadAndZeroForTheFirstSolveIsRejected) {
   EXPECT_EQ(c.estimator.max_iterations, 5);
   EXPECT_EQ(c.estimator.init_max_iterations, 24);
   const std::string dir = test::scratchDir();
-  const std::string path = writeFile(
-      dir, "init.yaml", eurocYamlReplacing("init_max_iterations: 24", "init_max_iterations: 0"));
+  const std::string path = test::writeFile(
+      dir + "/init.yaml", eurocYamlReplacing("init_max_iterations: 24", "init_max_iterations: 0"));
   expectErrorMentioning([&] { Config::load(path); },
                         {"estimator.init_max_iterations", "must be at least 1"});
 }
 
 TEST(Config, NonRotationExtrinsicIsRejected) {
   const std::string dir = test::scratchDir();
-  const std::string path = writeFile(dir, "rot.yaml", eurocYamlReplacing("0.0148655429818", "2.0"));
+  const std::string path =
+      test::writeFile(dir + "/rot.yaml", eurocYamlReplacing("0.0148655429818", "2.0"));
   expectErrorMentioning([&] { Config::load(path); }, {"camera.T_BS", "not a rotation"});
 }
 
@@ -136,8 +131,8 @@ TEST(Config, WrongListSizeIsRejected) {
 
 TEST(Config, UnknownKeysAreReported) {
   const std::string dir = test::scratchDir();
-  const std::string path = writeFile(
-      dir, "unknown.yaml",
+  const std::string path = test::writeFile(
+      dir + "/unknown.yaml",
       eurocYamlReplacing("rate_hz: 200", "rate_hz: 200\n  gravty: 9.8") + "imu_typo:\n  rate: 3\n");
   std::vector<std::string> warnings;
   setLogSink([&](LogLevel level, const std::string& msg) {
@@ -152,7 +147,7 @@ TEST(Config, UnknownKeysAreReported) {
 
 TEST(Config, YamlSyntaxErrorGivesLine) {
   const std::string dir = test::scratchDir();
-  const std::string path = writeFile(dir, "syntax.yaml", "a: 1\nb: [1, 2\nc: 3\n");
+  const std::string path = test::writeFile(dir + "/syntax.yaml", "a: 1\nb: [1, 2\nc: 3\n");
   expectErrorMentioning([&] { YamlReader r(path); }, {path, "line"});
 }
 
@@ -174,11 +169,12 @@ TEST(Config, EurocSensorYamlIsReadable) {
 
 TEST(ConfigBase, OverridesTheBaseKeyByKeyAndInheritsTheRest) {
   const std::string dir = test::scratchDir();
-  writeFile(dir, "robot.yaml", eurocYaml());
-  const std::string child = writeFile(dir, "child.yaml",
-                                      "base: robot.yaml\n"
-                                      "estimator:\n  window_size: 7\n"
-                                      "  imu_noise:\n    accelerometer_noise_density: 0.08\n");
+  test::writeFile(dir + "/robot.yaml", eurocYaml());
+  const std::string child =
+      test::writeFile(dir + "/child.yaml",
+                      "base: robot.yaml\n"
+                      "estimator:\n  window_size: 7\n"
+                      "  imu_noise:\n    accelerometer_noise_density: 0.08\n");
   const Config base = Config::load(dir + "/robot.yaml");
   const Config c = Config::load(child);
   EXPECT_EQ(c.estimator.window_size, 7);
@@ -192,12 +188,12 @@ TEST(ConfigBase, OverridesTheBaseKeyByKeyAndInheritsTheRest) {
 
 TEST(ConfigBase, MissingBaseAndCyclesNameTheFile) {
   const std::string dir = test::scratchDir();
-  const std::string orphan = writeFile(dir, "orphan.yaml", "base: nowhere.yaml\n");
+  const std::string orphan = test::writeFile(dir + "/orphan.yaml", "base: nowhere.yaml\n");
   expectErrorMentioning([&] { Config::load(orphan); }, {"orphan.yaml", "'base'", "nowhere.yaml"});
-  writeFile(dir, "a.yaml", "base: b.yaml\n");
-  const std::string b = writeFile(dir, "b.yaml", "base: a.yaml\n");
+  test::writeFile(dir + "/a.yaml", "base: b.yaml\n");
+  const std::string b = test::writeFile(dir + "/b.yaml", "base: a.yaml\n");
   expectErrorMentioning([&] { Config::load(b); }, {"'base'", "cycle"});
-  const std::string bad = writeFile(dir, "bad.yaml", "base: [1, 2]\n");
+  const std::string bad = test::writeFile(dir + "/bad.yaml", "base: [1, 2]\n");
   expectErrorMentioning([&] { Config::load(bad); }, {"bad.yaml", "'base' must name"});
 }
 
@@ -221,7 +217,7 @@ TEST(PackageFiles, AnInstalledProgramReadsItsInstalledConfigNotTheSourceTree) {
   fs::create_directories(prefix / "share/alvio/config");
   fs::create_directories(prefix / "lib/alvio");
   const std::string installed =
-      writeFile((prefix / "share/alvio/config").string(), "euroc.yaml", "installed: true\n");
+      test::writeFile((prefix / "share/alvio/config/euroc.yaml").string(), "installed: true\n");
   const std::string exe = (prefix / "lib/alvio/alvio_run").string();
   EXPECT_EQ(findPackageFile("config/euroc.yaml", exe), installed);
   // A file the install lacks comes from the source tree, as for a devel-space program.
