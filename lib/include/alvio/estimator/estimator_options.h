@@ -54,7 +54,7 @@ struct EstimatorOptions {
   double init_min_parallax_px = 40;
   double init_relaxed_parallax_px = 40;
   double init_relax_after_s = 1.5;
-  int init_min_correspondences = 20;
+  int init_min_correspondences = 15;
   double init_retry_interval_s = 0.1;
   double init_min_excitation = 0.005;  ///< std of mean acceleration per frame [m/s^2]
   double init_accel_bias_sigma = 0.2;  ///< bias prior at initialisation [m/s^2] (<= 0: none)
