@@ -29,6 +29,33 @@ Scene makeScene(int frames) {
   }
   return s;
 }
+
+// Every one of the first `points` points seen in every frame, without noise.
+std::vector<SfmTrack> fullTracks(const Scene& s, int frames, int points) {
+  std::vector<SfmTrack> tracks;
+  for (int i = 0; i < points; ++i) {
+    SfmTrack track;
+    track.id = i;
+    for (int k = 0; k < frames; ++k) track.sightings.emplace_back(k, s.observe(k, i));
+    tracks.push_back(track);
+  }
+  return tracks;
+}
+
+// Camera k's true position in the reference camera's frame, times `scale`.
+Eigen::Vector3d trueTranslation(const Scene& s, int ref, int k, double scale) {
+  return s.R[ref].transpose() * (s.t[k] - s.t[ref]) * scale;
+}
+
+// Reconstruct with the true reference-to-last pose, its translation scaled to unit length
+// (`scale`: that factor).
+bool reconstructFromTruePair(const Scene& s, int n, int ref, const std::vector<SfmTrack>& tracks,
+                             SfmResult* r, double* scale) {
+  const Eigen::Matrix3d R_ref_last = s.R[ref].transpose() * s.R[n - 1];
+  const Eigen::Vector3d t_ref_last = trueTranslation(s, ref, n - 1, 1.0);
+  *scale = 1.0 / t_ref_last.norm();
+  return reconstructStructure(n, ref, R_ref_last, t_ref_last * *scale, tracks, r);
+}
 }  // namespace
 
 TEST(StructureFromMotion, RelativePoseFromEssentialMatchesTruth) {
@@ -48,27 +75,16 @@ TEST(StructureFromMotion, RelativePoseFromEssentialMatchesTruth) {
 }
 
 TEST(StructureFromMotion, ReconstructsWindowUpToScale) {
-  const int n = 8;
+  const int n = 8, ref = 2;
   const Scene s = makeScene(n);
-  std::vector<SfmTrack> tracks;
-  for (int i = 0; i < 200; ++i) {
-    SfmTrack track;
-    track.id = i;
-    for (int k = 0; k < n; ++k) track.sightings.emplace_back(k, s.observe(k, i));
-    tracks.push_back(track);
-  }
-  const int ref = 2;
-  const Eigen::Matrix3d R_ref_last = s.R[ref].transpose() * s.R[n - 1];
-  const Eigen::Vector3d t_ref_last = s.R[ref].transpose() * (s.t[n - 1] - s.t[ref]);
-  const double scale = 1.0 / t_ref_last.norm();
   SfmResult r;
-  ASSERT_TRUE(reconstructStructure(n, ref, R_ref_last, t_ref_last * scale, tracks, &r));
+  double scale;
+  ASSERT_TRUE(reconstructFromTruePair(s, n, ref, fullTracks(s, n, 200), &r, &scale));
   for (int k = 0; k < n; ++k) {
     const Eigen::Matrix3d R_true = s.R[ref].transpose() * s.R[k];
-    const Eigen::Vector3d t_true = s.R[ref].transpose() * (s.t[k] - s.t[ref]) * scale;
     EXPECT_LT(Eigen::AngleAxisd(r.q_ref_c[k].toRotationMatrix().transpose() * R_true).angle(), 1e-5)
         << k;
-    EXPECT_LT((r.t_ref_c[k] - t_true).norm(), 1e-5) << k;
+    EXPECT_LT((r.t_ref_c[k] - trueTranslation(s, ref, k, scale)).norm(), 1e-5) << k;
   }
   EXPECT_EQ(r.points.size(), 200u);
 }
@@ -89,38 +105,22 @@ TEST(StructureFromMotion, ConvergesWithNoiseAndPartialTracks) {
     tracks.push_back(track);
   }
   const int ref = 3;
-  const Eigen::Matrix3d R_ref_last = s.R[ref].transpose() * s.R[n - 1];
-  const Eigen::Vector3d t_ref_last = s.R[ref].transpose() * (s.t[n - 1] - s.t[ref]);
-  const double scale = 1.0 / t_ref_last.norm();
   SfmResult r;
-  ASSERT_TRUE(reconstructStructure(n, ref, R_ref_last, t_ref_last * scale, tracks, &r));
-  for (int k = 0; k < n; ++k) {
-    const Eigen::Vector3d t_true = s.R[ref].transpose() * (s.t[k] - s.t[ref]) * scale;
-    EXPECT_LT((r.t_ref_c[k] - t_true).norm(), 0.02) << k;
-  }
+  double scale;
+  ASSERT_TRUE(reconstructFromTruePair(s, n, ref, tracks, &r, &scale));
+  for (int k = 0; k < n; ++k)
+    EXPECT_LT((r.t_ref_c[k] - trueTranslation(s, ref, k, scale)).norm(), 0.02) << k;
 }
 
 // A poorly textured scene: the frames between the reference and the last see only 12 points
 // (the low-texture corridor after a reset saw 11-14). Their poses still come out.
 TEST(StructureFromMotion, ReconstructsFromTwelvePointsPerFrame) {
-  const int n = 6;
+  const int n = 6, ref = 0;
   const Scene s = makeScene(n);
-  const int ref = 0;
-  std::vector<SfmTrack> tracks;
-  for (int i = 0; i < 12; ++i) {
-    SfmTrack track;
-    track.id = i;
-    for (int k = 0; k < n; ++k) track.sightings.emplace_back(k, s.observe(k, i));
-    tracks.push_back(track);
-  }
-  const Eigen::Matrix3d R_ref_last = s.R[ref].transpose() * s.R[n - 1];
-  const Eigen::Vector3d t_ref_last = s.R[ref].transpose() * (s.t[n - 1] - s.t[ref]);
-  const double scale = 1.0 / t_ref_last.norm();
   SfmResult r;
-  ASSERT_TRUE(reconstructStructure(n, ref, R_ref_last, t_ref_last * scale, tracks, &r));
-  for (int k = 0; k < n; ++k) {
-    const Eigen::Vector3d t_true = s.R[ref].transpose() * (s.t[k] - s.t[ref]) * scale;
-    EXPECT_LT((r.t_ref_c[k] - t_true).norm(), 1e-5) << k;
-  }
+  double scale;
+  ASSERT_TRUE(reconstructFromTruePair(s, n, ref, fullTracks(s, n, 12), &r, &scale));
+  for (int k = 0; k < n; ++k)
+    EXPECT_LT((r.t_ref_c[k] - trueTranslation(s, ref, k, scale)).norm(), 1e-5) << k;
   EXPECT_EQ(r.points.size(), 12u);
 }
