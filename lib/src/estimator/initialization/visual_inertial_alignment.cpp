@@ -6,7 +6,9 @@
 namespace alvio {
 namespace {
 
-// Gyroscope bias from the rotations between consecutive frames.
+// Gyroscope bias from the rotations between consecutive frames. Each residual is linear in
+// the bias's offset from the preintegration's own linearisation bias, which after a reset is
+// the bias kept from the run before, not zero: solve for the bias itself.
 Eigen::Vector3d solveGyroBias(const std::vector<AlignmentFrame>& frames) {
   Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
   Eigen::Vector3d b = Eigen::Vector3d::Zero();
@@ -16,7 +18,7 @@ Eigen::Vector3d solveGyroBias(const std::vector<AlignmentFrame>& frames) {
     const Eigen::Matrix3d J = pre.jacobian().block<3, 3>(kIdxQ, kIdxBg);
     const Eigen::Vector3d r = 2.0 * (pre.deltaQ().inverse() * q_ij).vec();
     A += J.transpose() * J;
-    b += J.transpose() * r;
+    b += J.transpose() * (r + J * pre.linearizedBg());
   }
   return A.ldlt().solve(b);
 }
