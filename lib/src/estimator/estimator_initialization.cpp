@@ -152,7 +152,7 @@ bool Estimator::initialStructure(double t) {
       pts.push_back(it->second);
       obs.push_back(xy1.head<2>());
     }
-    if (pts.size() < 6 || !cameraPoseFromPoints(pts, obs, &R_ref_c, &t_ref_c)) {
+    if (!cameraPoseFromPoints(pts, obs, &R_ref_c, &t_ref_c)) {
       waitFor(&last_wait_reason_, &events_, t, "PnP failed for a non-keyframe frame");
       return false;
     }
