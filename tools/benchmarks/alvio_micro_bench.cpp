@@ -1,7 +1,7 @@
 // alvio_micro_bench: Google Benchmark micro-benchmarks of the hot paths: line detection and
-// tracking and point tracking on a fixed frame pair, IMU preintegration, factor evaluation and
-// one estimator step (window optimisation) on a synthetic scenario. Built by ./alvio build,
-// never run in CI (timings on shared machines are for people, not for assertions).
+// tracking, point tracking and corner detection on a fixed frame pair, IMU preintegration,
+// factor evaluation and one estimator step (window optimisation) on a synthetic scenario. Built by
+// ./alvio build, never run in CI (timings on shared machines are for people, not for assertions).
 //
 //   alvio_micro_bench [--benchmark_filter=Line] [google benchmark flags]
 //
@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <iostream>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "alvio/camera/camera_model.h"
 #include "alvio/common/error.h"
@@ -22,6 +23,7 @@
 #include "alvio/estimator/estimator.h"
 #include "alvio/estimator/factors/imu_factor.h"
 #include "alvio/estimator/factors/point_projection_factor.h"
+#include "alvio/frontend/corner_detector.h"
 #include "alvio/frontend/point_tracker.h"
 #include "alvio/geometry/line_projection_factor.h"
 #include "alvio/imu/imu_preintegration.h"
@@ -139,6 +141,38 @@ void BM_PointTracking(benchmark::State& state) {
   state.counters["points"] = n;
 }
 BENCHMARK(BM_PointTracking)->Unit(benchmark::kMillisecond);
+
+// New corners for a frame that still tracks 120: the point tracker's discs around those,
+// 30 wanted. OpenCV's goodFeaturesToTrack against alvio's CornerDetector (the same corners).
+cv::Mat trackedCornersMask(const cv::Mat& image) {
+  const PointTrackerOptions& o = config().points;
+  std::vector<cv::Point2f> tracked;
+  cv::goodFeaturesToTrack(image, tracked, 120, o.quality_level, o.min_distance_px);
+  cv::Mat mask(image.size(), CV_8UC1, cv::Scalar(255));
+  for (const cv::Point2f& p : tracked) cv::circle(mask, p, o.min_distance_px, 0, -1);
+  return mask;
+}
+void BM_CornerDetectionOpenCv(benchmark::State& state) {
+  const cv::Mat& image = framePair().a;
+  const cv::Mat mask = trackedCornersMask(image);
+  const PointTrackerOptions& o = config().points;
+  std::vector<cv::Point2f> corners;
+  for (auto _ : state)
+    cv::goodFeaturesToTrack(image, corners, 30, o.quality_level, o.min_distance_px, mask);
+  state.counters["corners"] = static_cast<double>(corners.size());
+}
+BENCHMARK(BM_CornerDetectionOpenCv)->Unit(benchmark::kMillisecond);
+void BM_CornerDetection(benchmark::State& state) {
+  const cv::Mat& image = framePair().a;
+  const cv::Mat mask = trackedCornersMask(image);
+  const PointTrackerOptions& o = config().points;
+  CornerDetector detector;
+  std::size_t n = 0;
+  for (auto _ : state)
+    n = detector.detect(image, 30, o.quality_level, o.min_distance_px, mask).size();
+  state.counters["corners"] = static_cast<double>(n);
+}
+BENCHMARK(BM_CornerDetection)->Unit(benchmark::kMillisecond);
 
 // One frame interval of IMU at 200 Hz (10 midpoint steps with covariance propagation).
 void BM_ImuPreintegration(benchmark::State& state) {

@@ -186,9 +186,8 @@ void PointTracker::detectNew(const cv::Mat& img) {
   }
   const int wanted = options_.max_features - static_cast<int>(pts.size());
   if (wanted > 0) {
-    std::vector<cv::Point2f> corners;
-    cv::goodFeaturesToTrack(img, corners, wanted, options_.quality_level, options_.min_distance_px,
-                            mask);
+    const std::vector<cv::Point2f> corners =
+        corners_.detect(img, wanted, options_.quality_level, options_.min_distance_px, mask);
     for (const auto& c : corners) {
       pts.push_back(c);
       ids.push_back(next_id_++);

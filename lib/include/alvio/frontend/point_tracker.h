@@ -11,6 +11,7 @@
 
 #include "alvio/camera/camera_model.h"
 #include "alvio/common/timing.h"
+#include "alvio/frontend/corner_detector.h"
 #include "alvio/frontend/feature_frame.h"
 
 namespace alvio {
@@ -56,6 +57,7 @@ class PointTracker {
   PointTrackerOptions options_;
   std::shared_ptr<const CameraModel> camera_;
   cv::Ptr<cv::CLAHE> clahe_;
+  CornerDetector corners_;
   cv::Mat prev_img_;
   int64_t prev_t_ns_ = 0;
   std::vector<cv::Point2f> pts_;

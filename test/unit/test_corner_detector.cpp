@@ -1,0 +1,96 @@
+// The corner detector returns exactly cv::goodFeaturesToTrack's corners, in its order, on
+// textured, tied and masked images, and on real EuRoC frames when the shared data is here.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "alvio/frontend/corner_detector.h"
+#include "test_support.h"
+
+using namespace alvio;
+
+namespace {
+cv::Mat texture(cv::Size size, int seed) {
+  cv::Mat noise(size, CV_8UC1);
+  cv::RNG rng(seed);
+  rng.fill(noise, cv::RNG::UNIFORM, 0, 256);
+  cv::GaussianBlur(noise, noise, cv::Size(0, 0), 2.0);
+  return noise;
+}
+
+// Equal responses everywhere inside: the tie rule decides the order.
+cv::Mat checkerboard(cv::Size size, int square) {
+  cv::Mat img(size, CV_8UC1);
+  for (int y = 0; y < size.height; ++y)
+    for (int x = 0; x < size.width; ++x)
+      img.at<uchar>(y, x) = ((x / square + y / square) % 2) ? 200 : 40;
+  return img;
+}
+
+// The point tracker's mask: discs around corners it already tracks.
+cv::Mat discMask(cv::Size size, int discs, int radius, int seed) {
+  cv::Mat mask(size, CV_8UC1, cv::Scalar(255));
+  cv::RNG rng(seed);
+  for (int i = 0; i < discs; ++i)
+    cv::circle(mask, {rng.uniform(0, size.width), rng.uniform(0, size.height)}, radius, 0, -1);
+  return mask;
+}
+
+void expectSameAsOpenCv(CornerDetector* detector, const cv::Mat& img, int max_corners,
+                        double quality, double min_distance, const cv::Mat& mask) {
+  std::vector<cv::Point2f> expected;
+  cv::goodFeaturesToTrack(img, expected, max_corners, quality, min_distance, mask);
+  const std::vector<cv::Point2f> got =
+      detector->detect(img, max_corners, quality, min_distance, mask);
+  ASSERT_EQ(got.size(), expected.size())
+      << "max " << max_corners << ", distance " << min_distance << ", mask " << !mask.empty();
+  for (std::size_t i = 0; i < got.size(); ++i) EXPECT_EQ(got[i], expected[i]) << "corner " << i;
+}
+}  // namespace
+
+TEST(CornerDetector, MatchesGoodFeaturesToTrackOnTexture) {
+  const cv::Size size(752, 480);
+  CornerDetector detector;  // one detector throughout: its buffers carry over
+  for (int seed = 1; seed <= 3; ++seed) {
+    const cv::Mat img = texture(size, seed);
+    for (int max_corners : {1, 30, 150, 3000})
+      for (double min_distance : {0.0, 5.0, 30.0}) {
+        expectSameAsOpenCv(&detector, img, max_corners, 0.01, min_distance, cv::Mat());
+        expectSameAsOpenCv(&detector, img, max_corners, 0.01, min_distance,
+                           discMask(size, 120, 30, seed));
+      }
+  }
+}
+
+TEST(CornerDetector, MatchesGoodFeaturesToTrackWhereResponsesTie) {
+  CornerDetector detector;
+  const cv::Mat img = checkerboard({752, 480}, 16);
+  for (int max_corners : {10, 150, 5000})
+    for (double min_distance : {0.0, 3.0, 30.0})
+      expectSameAsOpenCv(&detector, img, max_corners, 0.01, min_distance, cv::Mat());
+}
+
+TEST(CornerDetector, MatchesGoodFeaturesToTrackOnEurocFrames) {
+  ALVIO_REQUIRE_SHARED_DATA(shared);
+  const std::filesystem::path dir =
+      std::filesystem::path(shared) / "euroc_V1_01_easy_micro_kimera/mav0/cam0/data";
+  if (!std::filesystem::is_directory(dir)) GTEST_SKIP() << dir << " not found: skipping";
+  CornerDetector detector;
+  int frames = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    const cv::Mat img = cv::imread(entry.path().string(), cv::IMREAD_GRAYSCALE);
+    ASSERT_FALSE(img.empty()) << entry.path();
+    expectSameAsOpenCv(&detector, img, 150, 0.01, 30, cv::Mat());
+    expectSameAsOpenCv(&detector, img, 40, 0.01, 30, discMask(img.size(), 110, 30, frames));
+    if (++frames == 5) break;
+  }
+  EXPECT_EQ(frames, 5);
+}
+
+TEST(CornerDetector, EmptyWhenTheMaskCoversEverything) {
+  CornerDetector detector;
+  const cv::Mat img = texture({200, 100}, 7);
+  EXPECT_TRUE(detector.detect(img, 50, 0.01, 10, cv::Mat::zeros(img.size(), CV_8UC1)).empty());
+}
