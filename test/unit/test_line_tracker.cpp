@@ -251,9 +251,10 @@ TEST(OpticalFlowLineTracker, DetectEveryOtherFrameCarriesLinesOnTheirFlow) {
   EXPECT_GT(f3.stats.detected, 0);
   EXPECT_EQ(f3.stats.tracked, static_cast<int>(f1.lines.size()));
   EXPECT_EQ(f3.stats.new_lines, 2);
-  for (const auto& obs : f3.lines) {
-    if (before.count(obs.id)) EXPECT_EQ(obs.track_count, 3);
-  }
+  for (const auto& obs : f3.lines)
+    if (before.count(obs.id)) {
+      EXPECT_EQ(obs.track_count, 3);
+    }
 }
 
 TEST(OpticalFlowLineTracker, FlowThatLosesMostLinesMakesTheNextFrameDetect) {
