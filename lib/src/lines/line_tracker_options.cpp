@@ -40,6 +40,7 @@ LineDetectorOptions LineDetectorOptions::load(const YamlReader& yaml, const std:
   o.lsd_refine = yaml.getBool(p + "lsd_refine", o.lsd_refine);
   o.lsd_quant = yaml.getDouble(p + "lsd_quant", o.lsd_quant);
   o.border_margin_px = yaml.getInt(p + "border_margin_px", o.border_margin_px);
+  o.refine_edges = yaml.getBool(p + "refine_edges", o.refine_edges);
   o.validate(whereOf(yaml, prefix));
   return o;
 }

@@ -45,6 +45,9 @@ struct LineDetectorOptions {
   /// Segments must keep this distance [px] from the invalid (unmapped) border of the
   /// undistorted image.
   int border_margin_px = 2;
+  /// Move each segment found on a scaled image onto its edge in the full-resolution image
+  /// (edge_refinement.h).
+  bool refine_edges = false;
 
   static LineDetectorOptions load(const YamlReader& yaml, const std::string& prefix);
   void validate(const std::string& where) const;
