@@ -72,19 +72,26 @@ bool refineSegmentToEdge(const cv::Mat& image, const EdgeRefinementOptions& opti
     peaks.push_back(base[s] + ((best - half + delta) * kStepPx) * normal);
   }
 
-  // Fit, drop outliers once, fit again.
+  // Fit, then drop the worst peak and fit again until every peak is within max_residual_px:
+  // one peak on a neighbouring edge must not tilt the line away from all the others.
+  const std::size_t needed = std::max<std::size_t>(
+      3, static_cast<std::size_t>(std::ceil(options.min_inlier_fraction * samples)));
   LineSegment fit;
-  const std::size_t needed = static_cast<std::size_t>(
-      std::ceil(options.min_inlier_fraction * static_cast<double>(samples)));
-  if (peaks.size() < std::max<std::size_t>(3, needed) ||
-      !fitSegmentToPoints(peaks, segment->end - segment->start, &fit))
-    return false;
-  std::vector<Eigen::Vector2d> inliers;
-  for (const Eigen::Vector2d& p : peaks)
-    if (fit.distanceToLine(p) <= options.max_residual_px) inliers.push_back(p);
-  if (inliers.size() < std::max<std::size_t>(3, needed) ||
-      !fitSegmentToPoints(inliers, segment->end - segment->start, &fit))
-    return false;
+  const Eigen::Vector2d reference = segment->end - segment->start;
+  while (true) {
+    if (peaks.size() < needed || !fitSegmentToPoints(peaks, reference, &fit)) return false;
+    std::size_t worst = 0;
+    double worst_distance = -1;
+    for (std::size_t i = 0; i < peaks.size(); ++i) {
+      const double d = fit.distanceToLine(peaks[i]);
+      if (d > worst_distance) {
+        worst_distance = d;
+        worst = i;
+      }
+    }
+    if (worst_distance <= options.max_residual_px) break;
+    peaks.erase(peaks.begin() + static_cast<std::ptrdiff_t>(worst));
+  }
 
   // The detector's extent, projected onto the refined line.
   const LineSegment refined(fit.pointAt(fit.positionAlong(segment->start)),
