@@ -544,3 +544,68 @@ TEST(LineTrackerOptions, ShippedConfigHasTheLinesSection) {
   LineTrackerOptions::load(yaml, "lines");
   for (const auto& key : yaml.unknownKeys()) EXPECT_NE(key.rfind("lines", 0), 0u) << key;
 }
+
+namespace {
+// A flow tracker whose detector can be made to find nothing on a frame (as when LSD misses a
+// line, or edge refinement drops it).
+class TrackerMissingDetections : public OpticalFlowLineTracker {
+ public:
+  using OpticalFlowLineTracker::OpticalFlowLineTracker;
+  LineFrame trackFindingNothing(const cv::Mat& image, double t) {
+    LineFrame frame;
+    frame.t = t;
+    associate(image, {}, /*detected=*/true, &frame);
+    return frame;
+  }
+};
+
+// kBars over frames 0..n-1, moving by (2, 1) px a frame; the frames in `missed` are detection
+// frames whose detector finds nothing.
+std::vector<LineFrame> trackMissing(int max_missed, int n, const std::set<int>& missed) {
+  const test::SyntheticLineScene scene(kSize);
+  LineTrackerOptions options = defaultOptions();
+  options.flow.max_missed_detections = max_missed;
+  TrackerMissingDetections tracker(test::undistortedCamera(), options);
+  std::vector<LineFrame> frames;
+  for (int k = 0; k < n; ++k) {
+    const cv::Mat image = scene.render(kBars, {2.0 * k, 1.0 * k});
+    frames.push_back(missed.count(k) ? tracker.trackFindingNothing(image, 0.05 * k)
+                                     : tracker.track(image, 0.05 * k));
+  }
+  return frames;
+}
+
+std::set<int> idsOf(const LineFrame& f) {
+  std::set<int> ids;
+  for (const auto& o : f.lines) ids.insert(o.id);
+  return ids;
+}
+}  // namespace
+
+TEST(OpticalFlowLineTracker, AMissedDetectionFrameIsBridgedByFlowWhenAllowed) {
+  const auto frames = trackMissing(1, 4, {2});
+  const std::set<int> first = idsOf(frames[0]);
+  ASSERT_GE(first.size(), 6u);
+  // The missed frame's lines are the flow's, and the next clean frame's detections continue the
+  // same tracks.
+  EXPECT_EQ(idsOf(frames[2]), first);
+  EXPECT_EQ(idsOf(frames[3]), first);
+  for (const auto& o : frames[3].lines) EXPECT_EQ(o.track_count, 4);
+}
+
+TEST(OpticalFlowLineTracker, AMissedDetectionFrameEndsTracksByDefault) {
+  const auto frames = trackMissing(0, 4, {2});
+  const std::set<int> first = idsOf(frames[0]);
+  ASSERT_GE(first.size(), 6u);
+  EXPECT_TRUE(frames[2].lines.empty());
+  for (int id : idsOf(frames[3])) EXPECT_EQ(first.count(id), 0u) << "id " << id;
+}
+
+TEST(OpticalFlowLineTracker, TwoMissedDetectionFramesInARowEndTracks) {
+  const auto frames = trackMissing(1, 5, {2, 3});
+  const std::set<int> first = idsOf(frames[0]);
+  ASSERT_GE(first.size(), 6u);
+  EXPECT_EQ(idsOf(frames[2]), first);
+  EXPECT_TRUE(frames[3].lines.empty());
+  for (int id : idsOf(frames[4])) EXPECT_EQ(first.count(id), 0u) << "id " << id;
+}
