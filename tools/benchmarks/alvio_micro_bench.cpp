@@ -68,11 +68,13 @@ const FramePair& framePair() {
   return pair;
 }
 
-void detectLines(benchmark::State& state, const std::string& method, double fld_scale = 1.0) {
+void detectLines(benchmark::State& state, const std::string& method, double fld_scale = 1.0,
+                 bool refine_edges = false) {
   const FramePair& f = framePair();
   LineDetectorOptions options = config().lines.detector;
   options.method = method;
   options.fld_scale = fld_scale;
+  options.refine_edges = refine_edges;
   LineDetector detector(options, f.a.size());
   std::size_t n = 0;
   for (auto _ : state) n = detector.detect(f.a).size();
@@ -81,6 +83,9 @@ void detectLines(benchmark::State& state, const std::string& method, double fld_
 void BM_LineDetectionLsd(benchmark::State& state) {
   detectLines(state, "lsd");
 }
+void BM_LineDetectionLsdRefined(benchmark::State& state) {
+  detectLines(state, "lsd", 1.0, true);
+}
 void BM_LineDetectionFld(benchmark::State& state) {
   detectLines(state, "fld");
 }
@@ -88,6 +93,7 @@ void BM_LineDetectionFldHalfScale(benchmark::State& state) {
   detectLines(state, "fld", 0.5);
 }
 BENCHMARK(BM_LineDetectionLsd)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_LineDetectionLsdRefined)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_LineDetectionFld)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_LineDetectionFldHalfScale)->Unit(benchmark::kMillisecond);
 
