@@ -77,7 +77,6 @@ FlowLineTrackerOptions FlowLineTrackerOptions::load(const YamlReader& yaml,
   o.min_length_ratio = yaml.getDouble(p + "min_length_ratio", o.min_length_ratio);
   o.max_center_distance_px = yaml.getDouble(p + "max_center_distance_px", o.max_center_distance_px);
   o.detect_every = yaml.getInt(p + "detect_every", o.detect_every);
-  o.max_missed_detections = yaml.getInt(p + "max_missed_detections", o.max_missed_detections);
   o.validate(whereOf(yaml, prefix));
   return o;
 }
@@ -101,8 +100,6 @@ void FlowLineTrackerOptions::validate(const std::string& where) const {
   require(max_center_distance_px > 0, where, "max_center_distance_px", "positive",
           max_center_distance_px);
   require(detect_every >= 1, where, "detect_every", ">= 1", detect_every);
-  require(max_missed_detections >= 0, where, "max_missed_detections", "non-negative",
-          max_missed_detections);
 }
 
 DescriptorLineTrackerOptions DescriptorLineTrackerOptions::load(const YamlReader& yaml,

@@ -208,7 +208,7 @@ std::vector<OpticalFlowLineTracker::Track> OpticalFlowLineTracker::carryPredicti
     const Prediction& p = predictions_[i];
     // As short as a detection may be and still continue a track, at the least.
     if (!p.valid || p.segment.length() < detector().shortestLength()) continue;
-    next.push_back({tracks_[i].id, p.segment, tracks_[i].count + 1, tracks_[i].missed});
+    next.push_back({tracks_[i].id, p.segment, tracks_[i].count + 1});
     ++frame->stats.tracked;
     frame->stats.clipped += p.clipped;
   }
@@ -261,22 +261,9 @@ std::vector<OpticalFlowLineTracker::Track> OpticalFlowLineTracker::match(
   };
   std::vector<bool> used(detections.size(), false);
   std::vector<Track> next;
-  // A line without a detection lives on its prediction while it may still miss one.
-  auto carryMissed = [&](std::size_t i) {
-    const Prediction& p = predictions_[i];
-    if (!p.valid || p.segment.length() < detector().shortestLength() ||
-        tracks_[i].missed >= f.max_missed_detections)
-      return;
-    next.push_back({tracks_[i].id, p.segment, tracks_[i].count + 1, tracks_[i].missed + 1});
-    ++frame->stats.tracked;
-    frame->stats.clipped += p.clipped;
-  };
   for (std::size_t i = 0; i < predictions_.size(); ++i) {
     const std::vector<int>& dets = assigned[i];
-    if (dets.empty()) {
-      carryMissed(i);
-      continue;
-    }
+    if (dets.empty()) continue;
     const LineSegment& pred = predictions_[i].segment;
     LineSegment result;
     bool merged = false, accepted = false;
@@ -292,10 +279,7 @@ std::vector<OpticalFlowLineTracker::Track> OpticalFlowLineTracker::match(
       result = detections[dets.front()];
       used[dets.front()] = accepted = true;
     }
-    if (!accepted) {
-      carryMissed(i);
-      continue;
-    }
+    if (!accepted) continue;
     next.push_back({tracks_[i].id, result, tracks_[i].count + 1});
     ++frame->stats.tracked;
     frame->stats.merged += merged;

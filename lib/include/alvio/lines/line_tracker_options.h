@@ -77,9 +77,6 @@ struct FlowLineTrackerOptions {
   /// 1: every frame, as in the paper. 2 halves LSD's cost, and tracks last 1.5x longer with
   /// as many correct associations (docs/benchmarks.md).
   int detect_every = 2;
-  /// A tracked line that finds no detection on a detection frame continues on its flow
-  /// prediction for up to this many detection frames in a row (0: it ends at once).
-  int max_missed_detections = 0;
 
   static FlowLineTrackerOptions load(const YamlReader& yaml, const std::string& prefix);
   void validate(const std::string& where) const;

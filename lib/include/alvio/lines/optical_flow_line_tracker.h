@@ -27,7 +27,7 @@
 
 namespace alvio {
 
-class OpticalFlowLineTracker : public LineTracker {
+class OpticalFlowLineTracker final : public LineTracker {
  public:
   OpticalFlowLineTracker(const CameraOptions& camera, const LineTrackerOptions& options);
   const char* name() const override { return "flow"; }
@@ -51,7 +51,6 @@ class OpticalFlowLineTracker : public LineTracker {
     int id;
     LineSegment segment;
     int count;
-    int missed = 0;  ///< detection frames in a row that found no detection for it
   };
   void predict(const std::vector<cv::Mat>& pyramid, cv::Size image_size);
   /// Steps 2 and 3: this frame's lines from the predictions and the detections.
