@@ -53,6 +53,9 @@ void toMsg(const alvio::FeatureFrame& frame, const alvio::FrameTiming& timing,
     set2(m.start_norm, l.start_norm);
     set2(m.end_norm, l.end_norm);
     m.track_count = l.track_count;
+    m.on_edge = l.on_edge;
+    set2(m.edge_start_norm, l.edge_start_norm);
+    set2(m.edge_end_norm, l.edge_end_norm);
   }
   auto& s = msg->stats;
   s.points = static_cast<int32_t>(frame.points.size());
@@ -95,6 +98,9 @@ alvio::FeatureFrame fromMsg(const alvio::TrackedFeatures& msg) {
     l.start_norm = get2(m.start_norm);
     l.end_norm = get2(m.end_norm);
     l.track_count = m.track_count;
+    l.on_edge = m.on_edge;
+    l.edge_start_norm = get2(m.edge_start_norm);
+    l.edge_end_norm = get2(m.edge_end_norm);
   }
   const auto& s = msg.stats;
   f.line_stats.detected = s.lines_detected;

@@ -31,6 +31,9 @@ alvio::FeatureFrame sampleFrame() {
   l.start_norm = {-0.5, -0.25};
   l.end_norm = {0.25, 0.375};
   l.track_count = 4;
+  l.on_edge = true;
+  l.edge_start_norm = {-0.5, -0.25625};
+  l.edge_end_norm = {0.25, 0.38125};
   f.lines.push_back(l);
   f.line_stats.detected = 40;
   f.line_stats.tracked = 30;
@@ -126,6 +129,9 @@ TEST(RosMessages, FeatureFrameSurvivesTheMessage) {
   EXPECT_EQ(out.lines[0].start_norm, in.lines[0].start_norm);
   EXPECT_EQ(out.lines[0].end_norm, in.lines[0].end_norm);
   EXPECT_EQ(out.lines[0].track_count, 4);
+  EXPECT_TRUE(out.lines[0].on_edge);
+  EXPECT_EQ(out.lines[0].edge_start_norm, in.lines[0].edge_start_norm);
+  EXPECT_EQ(out.lines[0].edge_end_norm, in.lines[0].edge_end_norm);
   EXPECT_EQ(out.line_stats.detected, 40);
   EXPECT_EQ(out.line_stats.merged, 2);
   EXPECT_EQ(out.mean_intensity, 97.5);

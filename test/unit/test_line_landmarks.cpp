@@ -129,3 +129,42 @@ TEST(LineLandmarks, RetirementSummaryNamesTheLimitsAndWarnsWhenMostTracksFailThe
   EXPECT_FALSE(fitLimitLooksTooTight(early));
   EXPECT_FALSE(fitLimitLooksTooTight(LineRetirementCounts{}));
 }
+
+namespace {
+// Eight posed frames whose tracker positions lie on an edge 3 cm off the true one, and whose
+// full-resolution edge positions (lines.map_edges) lie on the true edge in the first
+// `on_edge` frames.
+LineLandmark retireWithEdgePositions(int on_edge) {
+  LineLandmarks lines(3, LineTriangulationOptions{});
+  for (int k = 0; k < 8; ++k) {
+    auto obs = observeEdge(k, Eigen::Vector3d(0, 0, 0.03));
+    if (k < on_edge) {
+      obs[0].on_edge = true;
+      obs[0].edge_start_norm = projectNormalised(cameraAt(k), kP);
+      obs[0].edge_end_norm = projectNormalised(cameraAt(k), kQ);
+    }
+    lines.addFrame(stamp(k), obs);
+  }
+  lines.triangulate([](int64_t ns) { return cameraAt(static_cast<int>(ns - 1000)); });
+  for (int k = 0; k < 8; ++k) {
+    const Eigen::Isometry3d T = cameraAt(k);
+    lines.removeFrame(stamp(k), &T);
+  }
+  const std::vector<LineLandmark> retired = lines.takeRetired();
+  EXPECT_EQ(retired.size(), 1u);
+  return retired.empty() ? LineLandmark() : retired[0];
+}
+}  // namespace
+
+TEST(LineLandmarks, RetirementFitsTheEdgePositionsWhenHalfTheTrackHasThem) {
+  const LineLandmark all = retireWithEdgePositions(8);
+  EXPECT_EQ(all.track_observations, 8);
+  EXPECT_LT(extentError(all), 1e-6);
+  const LineLandmark half = retireWithEdgePositions(4);
+  EXPECT_EQ(half.track_observations, 4);  // the four on the edge, the others left out
+  EXPECT_LT(extentError(half), 1e-6);
+  // Fewer than half: the tracker's positions, 3 cm off.
+  const LineLandmark few = retireWithEdgePositions(3);
+  EXPECT_EQ(few.track_observations, 8);
+  EXPECT_NEAR(extentError(few), 0.03, 0.01);
+}

@@ -35,6 +35,9 @@ void LineLandmarks::addFrame(
     LineLandmarkObservation obs;
     obs.start_norm = o.start_norm;
     obs.end_norm = o.end_norm;
+    obs.on_edge = o.on_edge;
+    obs.edge_start_norm = o.edge_start_norm;
+    obs.edge_end_norm = o.edge_end_norm;
     auto [it, inserted] = landmarks_.try_emplace(o.id);
     if (inserted)
       it->second.id = o.id;
@@ -54,20 +57,31 @@ void LineLandmarks::removeFrame(int64_t frame_ns, const Eigen::Isometry3d* T_w_c
       v.start_norm = obs->second.start_norm;
       v.end_norm = obs->second.end_norm;
       history_[l.id].push_back(v);
+      if (obs->second.on_edge) {
+        v.start_norm = obs->second.edge_start_norm;
+        v.end_norm = obs->second.edge_end_norm;
+        edge_history_[l.id].push_back(v);
+      }
     }
     if (obs != l.observations.end()) l.observations.erase(obs);
     if (!l.observations.empty()) {
       ++it;
       continue;
     }
-    retire(l, history_[l.id]);
+    retire(l, history_[l.id], edge_history_[l.id]);
     history_.erase(l.id);
+    edge_history_.erase(l.id);
     it = landmarks_.erase(it);
   }
 }
 
-void LineLandmarks::retire(const LineLandmark& l, const LineViews& views) {
-  // One refinement over every observation of the track, for the map.
+void LineLandmarks::retire(const LineLandmark& l, const LineViews& all_views,
+                           const LineViews& edge_views) {
+  // One refinement over every observation of the track, for the map: over those found on
+  // their full-resolution edge (lines.map_edges) when they are at least half of the track.
+  // The others are left out, not mixed in: the two positions differ by a few tenths of a
+  // pixel, and tracks mixing them fitted worse (docs/benchmarks.md, eighteenth session).
+  const LineViews& views = 2 * edge_views.size() >= all_views.size() ? edge_views : all_views;
   if (!usableForRetirement(l, views)) return;
   PluckerLine line = l.line_w;
   Eigen::Vector3d a, b;

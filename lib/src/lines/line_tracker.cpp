@@ -4,6 +4,7 @@
 
 #include "alvio/common/error.h"
 #include "alvio/lines/descriptor_line_tracker.h"
+#include "alvio/lines/edge_refinement.h"
 #include "alvio/lines/optical_flow_line_tracker.h"
 
 namespace alvio {
@@ -48,6 +49,12 @@ LineFrame LineTracker::trackUndistorted(const cv::Mat& undistorted, double t) {
   for (LineObservation& obs : frame.lines) {
     obs.start_norm = undistorter_.pixelToNormalised(obs.start_px);
     obs.end_norm = undistorter_.pixelToNormalised(obs.end_px);
+    LineSegment edge(obs.start_px, obs.end_px);
+    if (options_.map_edges && refineSegmentToEdge(undistorted, EdgeRefinementOptions(), &edge)) {
+      obs.on_edge = true;
+      obs.edge_start_norm = undistorter_.pixelToNormalised(edge.start);
+      obs.edge_end_norm = undistorter_.pixelToNormalised(edge.end);
+    }
   }
   frame.stats.track_ms = msSince(start);
   return frame;

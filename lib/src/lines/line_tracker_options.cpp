@@ -129,6 +129,7 @@ LineTrackerOptions LineTrackerOptions::load(const YamlReader& yaml, const std::s
   const std::string p = keyPrefix(prefix);
   o.tracker = yaml.getString(p + "tracker", o.tracker);
   o.own_thread = yaml.getBool(p + "own_thread", o.own_thread);
+  o.map_edges = yaml.getBool(p + "map_edges", o.map_edges);
   o.detector = LineDetectorOptions::load(yaml, p + "detector");
   o.flow = FlowLineTrackerOptions::load(yaml, p + "flow");
   o.descriptor = DescriptorLineTrackerOptions::load(yaml, p + "descriptor");

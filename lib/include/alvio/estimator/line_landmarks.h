@@ -84,6 +84,7 @@ class LineLandmarks {
   void clear() {
     landmarks_.clear();
     history_.clear();
+    edge_history_.clear();
   }
   /// Lines retired since the last call, refined over their whole track (world frame).
   std::vector<LineLandmark> takeRetired();
@@ -98,7 +99,7 @@ class LineLandmarks {
   const std::map<int, LineLandmark>& landmarks() const { return landmarks_; }
 
  private:
-  void retire(const LineLandmark& l, const LineViews& views);
+  void retire(const LineLandmark& l, const LineViews& views, const LineViews& edge_views);
   bool usableForRetirement(const LineLandmark& l, const LineViews& views) const;
 
   int min_observations_;
@@ -106,6 +107,7 @@ class LineLandmarks {
   int last_tracked_ = 0;
   std::map<int, LineLandmark> landmarks_;  // by id: deterministic order
   std::map<int, LineViews> history_;       // observations of frames that left the window
+  std::map<int, LineViews> edge_history_;  // the same on their full-resolution edge, where found
   std::vector<LineLandmark> retired_;
   double sigma_ = 1.5 / 458.0;
   LineRetirementFilter filter_;

@@ -24,6 +24,11 @@ struct LineObservation {
   Eigen::Vector2d start_norm = Eigen::Vector2d::Zero();  ///< undistorted normalised
   Eigen::Vector2d end_norm = Eigen::Vector2d::Zero();
   int track_count = 1;  ///< frames this ID has been observed in, this one included
+  /// The segment moved onto its edge in the full-resolution image (lines.map_edges): used by
+  /// the line map's final fit only, the estimator keeps the positions above.
+  bool on_edge = false;
+  Eigen::Vector2d edge_start_norm = Eigen::Vector2d::Zero();
+  Eigen::Vector2d edge_end_norm = Eigen::Vector2d::Zero();
   EIGEN_MAKE_ALIGNED_OPERATOR_NEW
 };
 

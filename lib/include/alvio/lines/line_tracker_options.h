@@ -100,6 +100,9 @@ struct LineTrackerOptions {
   /// Track lines in a thread of their own, beside the point tracker (FrontEnd). The frames are
   /// the same either way; offline on two cores sim_MH_05 took 89 s instead of 103 s.
   bool own_thread = false;
+  /// Each observation is also moved onto its edge at full resolution (edge_refinement.h), for
+  /// the line map's final fit; the tracks and the estimator are unchanged.
+  bool map_edges = true;
   LineDetectorOptions detector;
   FlowLineTrackerOptions flow;
   DescriptorLineTrackerOptions descriptor;
