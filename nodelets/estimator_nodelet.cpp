@@ -396,6 +396,7 @@ class EstimatorNodelet : public GuardedNodelet {
     if (c.tracks() == 0) return;
     NODELET_INFO("lines for the map: %s",
                  alvio::describeLineRetirement(c, config_.estimator.line_map_max_rms_px,
+                                               config_.estimator.line_map_max_edge_rms_px,
                                                config_.estimator.line_map_min_parallax)
                      .c_str());
     if (alvio::fitLimitLooksTooTight(c)) NODELET_WARN("%s", alvio::kFitLimitHint);

@@ -117,6 +117,7 @@ int main(int argc, char** argv) {
     if (lr.tracks() > 0)
       std::cout << "lines for the maps: "
                 << describeLineRetirement(lr, config.estimator.line_map_max_rms_px,
+                                          config.estimator.line_map_max_edge_rms_px,
                                           config.estimator.line_map_min_parallax)
                 << "\n";
     if (fitLimitLooksTooTight(lr)) std::cout << "note: " << kFitLimitHint << "\n";

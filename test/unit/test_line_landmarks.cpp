@@ -118,9 +118,9 @@ TEST(LineLandmarks, RetirementSummaryNamesTheLimitsAndWarnsWhenMostTracksFailThe
   c.retired = 43;
   c.held_back_fit = 73;
   c.held_back_parallax = 32;
-  EXPECT_EQ(describeLineRetirement(c, 0.5, 0.1),
-            "43 of 148 retired tracks; held back: 73 fit worse than 0.5 px RMS, 32 with cross "
-            "parallax under 0.1");
+  EXPECT_EQ(describeLineRetirement(c, 0.5, 0.35, 0.1),
+            "43 of 148 retired tracks; held back: 73 fit worse than 0.35 px RMS on their edges "
+            "(0.5 px on the tracker's positions), 32 with cross parallax under 0.1");
   EXPECT_FALSE(fitLimitLooksTooTight(c));  // about half, as on the rendered benchmark
   c.held_back_fit = 300;                   // 300 of 375: 80 %
   EXPECT_TRUE(fitLimitLooksTooTight(c));
@@ -133,15 +133,19 @@ TEST(LineLandmarks, RetirementSummaryNamesTheLimitsAndWarnsWhenMostTracksFailThe
 namespace {
 // Eight posed frames whose tracker positions lie on an edge 3 cm off the true one, and whose
 // full-resolution edge positions (lines.map_edges) lie on the true edge in the first
-// `on_edge` frames.
-LineLandmark retireWithEdgePositions(int on_edge) {
+// `on_edge` frames, `edge_noise_px` up and down in turn.
+LineLandmark retireWithEdgePositions(int on_edge, const LineRetirementFilter& filter = {},
+                                     double edge_noise_px = 0,
+                                     LineRetirementCounts* counts = nullptr) {
   LineLandmarks lines(3, LineTriangulationOptions{});
+  lines.setRetirementFilter(filter);
   for (int k = 0; k < 8; ++k) {
     auto obs = observeEdge(k, Eigen::Vector3d(0, 0, 0.03));
     if (k < on_edge) {
+      const Eigen::Vector2d noise(0, (k % 2 ? 1 : -1) * edge_noise_px / 458.0);
       obs[0].on_edge = true;
-      obs[0].edge_start_norm = projectNormalised(cameraAt(k), kP);
-      obs[0].edge_end_norm = projectNormalised(cameraAt(k), kQ);
+      obs[0].edge_start_norm = projectNormalised(cameraAt(k), kP) + noise;
+      obs[0].edge_end_norm = projectNormalised(cameraAt(k), kQ) + noise;
     }
     lines.addFrame(stamp(k), obs);
   }
@@ -150,8 +154,8 @@ LineLandmark retireWithEdgePositions(int on_edge) {
     const Eigen::Isometry3d T = cameraAt(k);
     lines.removeFrame(stamp(k), &T);
   }
+  if (counts) *counts = lines.retirementCounts();
   const std::vector<LineLandmark> retired = lines.takeRetired();
-  EXPECT_EQ(retired.size(), 1u);
   return retired.empty() ? LineLandmark() : retired[0];
 }
 }  // namespace
@@ -167,4 +171,21 @@ TEST(LineLandmarks, RetirementFitsTheEdgePositionsWhenHalfTheTrackHasThem) {
   const LineLandmark few = retireWithEdgePositions(3);
   EXPECT_EQ(few.track_observations, 8);
   EXPECT_NEAR(extentError(few), 0.03, 0.01);
+}
+
+TEST(LineLandmarks, TracksOnTheirEdgesMeetTheEdgeFitLimit) {
+  LineRetirementFilter filter;
+  filter.max_reprojection_rms = 0.2 / 458.0;
+  filter.max_edge_reprojection_rms = 0.6 / 458.0;
+  LineRetirementCounts counts;
+  // Edge positions 0.4 px off in turn: within the edge limit, though not the other.
+  EXPECT_EQ(retireWithEdgePositions(8, filter, 0.4, &counts).track_observations, 8);
+  EXPECT_EQ(counts.retired, 1);
+  filter.max_edge_reprojection_rms = 0.3 / 458.0;
+  retireWithEdgePositions(8, filter, 0.4, &counts);
+  EXPECT_EQ(counts.held_back_fit, 1);
+  // A track fitted on the tracker's positions (too few on the edge) meets the other limit.
+  filter.max_edge_reprojection_rms = 0;
+  EXPECT_EQ(retireWithEdgePositions(3, filter, 0.4, &counts).track_observations, 8);
+  EXPECT_EQ(counts.retired, 1);
 }

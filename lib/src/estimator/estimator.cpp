@@ -28,6 +28,8 @@ Estimator::Estimator(const EstimatorOptions& options, const CameraOptions& camer
   LineRetirementFilter filter;
   if (options.line_map_max_rms_px > 0)
     filter.max_reprojection_rms = options.line_map_max_rms_px / camera.intrinsics[0];
+  if (options.line_map_max_edge_rms_px > 0)
+    filter.max_edge_reprojection_rms = options.line_map_max_edge_rms_px / camera.intrinsics[0];
   filter.min_cross_parallax = options.line_map_min_parallax;
   lines_.setRetirementFilter(filter);
   clearState();

@@ -38,6 +38,8 @@ EstimatorOptions EstimatorOptions::load(const YamlReader& yaml, const std::strin
   o.line_triangulation = LineTriangulationOptions::load(yaml, p + "line_triangulation");
   o.line_map_max_rms_px = yaml.getDouble(p + "line_map_max_rms_px", o.line_map_max_rms_px);
   o.line_map_min_parallax = yaml.getDouble(p + "line_map_min_parallax", o.line_map_min_parallax);
+  o.line_map_max_edge_rms_px =
+      yaml.getDouble(p + "line_map_max_edge_rms_px", o.line_map_max_edge_rms_px);
   o.selection = FeatureSelectionOptions::load(yaml, p + "selection");
   o.init_min_parallax_px = yaml.getDouble(p + "init_min_parallax_px", o.init_min_parallax_px);
   o.init_relaxed_parallax_px =

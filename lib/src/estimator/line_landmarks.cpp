@@ -12,11 +12,13 @@
 namespace alvio {
 
 std::string describeLineRetirement(const LineRetirementCounts& counts, double max_rms_px,
-                                   double min_parallax) {
+                                   double max_edge_rms_px, double min_parallax) {
   std::ostringstream os;
   os << counts.retired << " of " << counts.tracks()
-     << " retired tracks; held back: " << counts.held_back_fit << " fit worse than " << max_rms_px
-     << " px RMS, " << counts.held_back_parallax << " with cross parallax under " << min_parallax;
+     << " retired tracks; held back: " << counts.held_back_fit << " fit worse than "
+     << max_edge_rms_px << " px RMS on their edges (" << max_rms_px
+     << " px on the tracker's positions), " << counts.held_back_parallax
+     << " with cross parallax under " << min_parallax;
   return os.str();
 }
 
@@ -81,13 +83,15 @@ void LineLandmarks::retire(const LineLandmark& l, const LineViews& all_views,
   // their full-resolution edge (lines.map_edges) when they are at least half of the track.
   // The others are left out, not mixed in: the two positions differ by a few tenths of a
   // pixel, and tracks mixing them fitted worse (docs/benchmarks.md, eighteenth session).
-  const LineViews& views = 2 * edge_views.size() >= all_views.size() ? edge_views : all_views;
+  const bool on_edges = 2 * edge_views.size() >= all_views.size();
+  const LineViews& views = on_edges ? edge_views : all_views;
   if (!usableForRetirement(l, views)) return;
   PluckerLine line = l.line_w;
   Eigen::Vector3d a, b;
   if (!refineLine(views, triangulation_, &line) || !lineExtent(line, views, &a, &b, triangulation_))
     return;
-  if (lineReprojectionRms(line, views) > filter_.max_reprojection_rms) {
+  if (lineReprojectionRms(line, views) >
+      (on_edges ? filter_.max_edge_reprojection_rms : filter_.max_reprojection_rms)) {
     ++counts_.held_back_fit;
     return;
   }

@@ -42,6 +42,8 @@ struct EstimatorOptions {
   /// fraction of its distance (lineCrossParallax; 0: no limit). Tuned on the rendered
   /// benchmark (docs/truth_evaluation.md); the trajectory does not depend on them.
   double line_map_max_rms_px = 0.5;
+  /// The RMS limit for a track fitted on its full-resolution edge positions (lines.map_edges).
+  double line_map_max_edge_rms_px = 0.35;
   double line_map_min_parallax = 0.10;
 
   /// Sensitivity-based selection and adaptive weighting (estimator.selection).
