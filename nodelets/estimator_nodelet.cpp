@@ -395,9 +395,10 @@ class EstimatorNodelet : public GuardedNodelet {
     const alvio::LineRetirementCounts& c = estimator_->lineRetirementCounts();
     if (c.tracks() == 0) return;
     NODELET_INFO("lines for the map: %s",
-                 alvio::describeLineRetirement(c, config_.estimator.line_map_max_rms_px,
-                                               config_.estimator.line_map_max_edge_rms_px,
-                                               config_.estimator.line_map_min_parallax)
+                 alvio::describeLineRetirement(
+                     c, config_.estimator.line_map_max_rms_px,
+                     config_.lines.map_edges ? config_.estimator.line_map_max_edge_rms_px : 0.0,
+                     config_.estimator.line_map_min_parallax)
                      .c_str());
     if (alvio::fitLimitLooksTooTight(c)) NODELET_WARN("%s", alvio::kFitLimitHint);
   }

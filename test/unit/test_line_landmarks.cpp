@@ -121,6 +121,9 @@ TEST(LineLandmarks, RetirementSummaryNamesTheLimitsAndWarnsWhenMostTracksFailThe
   EXPECT_EQ(describeLineRetirement(c, 0.5, 0.35, 0.1),
             "43 of 148 retired tracks; held back: 73 fit worse than 0.35 px RMS on their edges "
             "(0.5 px on the tracker's positions), 32 with cross parallax under 0.1");
+  EXPECT_EQ(describeLineRetirement(c, 0.5, 0, 0.1),  // no edge positions (lines.map_edges off)
+            "43 of 148 retired tracks; held back: 73 fit worse than 0.5 px RMS, 32 with cross "
+            "parallax under 0.1");
   EXPECT_FALSE(fitLimitLooksTooTight(c));  // about half, as on the rendered benchmark
   c.held_back_fit = 300;                   // 300 of 375: 80 %
   EXPECT_TRUE(fitLimitLooksTooTight(c));

@@ -15,10 +15,13 @@ std::string describeLineRetirement(const LineRetirementCounts& counts, double ma
                                    double max_edge_rms_px, double min_parallax) {
   std::ostringstream os;
   os << counts.retired << " of " << counts.tracks()
-     << " retired tracks; held back: " << counts.held_back_fit << " fit worse than "
-     << max_edge_rms_px << " px RMS on their edges (" << max_rms_px
-     << " px on the tracker's positions), " << counts.held_back_parallax
-     << " with cross parallax under " << min_parallax;
+     << " retired tracks; held back: " << counts.held_back_fit << " fit worse than ";
+  if (max_edge_rms_px > 0)
+    os << max_edge_rms_px << " px RMS on their edges (" << max_rms_px
+       << " px on the tracker's positions), ";
+  else
+    os << max_rms_px << " px RMS, ";
+  os << counts.held_back_parallax << " with cross parallax under " << min_parallax;
   return os.str();
 }
 

@@ -39,8 +39,8 @@ struct LineRetirementCounts {
 };
 
 /// "43 of 148 retired tracks; held back: 73 fit worse than 0.35 px RMS on their edges (0.5 px
-/// on the tracker's positions), 32 with cross parallax under 0.1" (the limits as configured),
-/// for run summaries and logs.
+/// on the tracker's positions), 32 with cross parallax under 0.1" (the limits as configured;
+/// max_edge_rms_px <= 0 when there are no edge positions), for run summaries and logs.
 std::string describeLineRetirement(const LineRetirementCounts& counts, double max_rms_px,
                                    double max_edge_rms_px, double min_parallax);
 /// Over three quarters of at least kMinTracksToJudgeTheFitLimit tracks fail the fit limit. On
