@@ -53,6 +53,7 @@ void toMsg(const alvio::FeatureFrame& frame, const alvio::FrameTiming& timing,
     set2(m.start_norm, l.start_norm);
     set2(m.end_norm, l.end_norm);
     m.track_count = l.track_count;
+    m.edge_checked = l.edge_checked;
     m.on_edge = l.on_edge;
     set2(m.edge_start_norm, l.edge_start_norm);
     set2(m.edge_end_norm, l.edge_end_norm);
@@ -98,6 +99,7 @@ alvio::FeatureFrame fromMsg(const alvio::TrackedFeatures& msg) {
     l.start_norm = get2(m.start_norm);
     l.end_norm = get2(m.end_norm);
     l.track_count = m.track_count;
+    l.edge_checked = m.edge_checked;
     l.on_edge = m.on_edge;
     l.edge_start_norm = get2(m.edge_start_norm);
     l.edge_end_norm = get2(m.edge_end_norm);

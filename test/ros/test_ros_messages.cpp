@@ -31,6 +31,7 @@ alvio::FeatureFrame sampleFrame() {
   l.start_norm = {-0.5, -0.25};
   l.end_norm = {0.25, 0.375};
   l.track_count = 4;
+  l.edge_checked = true;
   l.on_edge = true;
   l.edge_start_norm = {-0.5, -0.25625};
   l.edge_end_norm = {0.25, 0.38125};
@@ -129,6 +130,7 @@ TEST(RosMessages, FeatureFrameSurvivesTheMessage) {
   EXPECT_EQ(out.lines[0].start_norm, in.lines[0].start_norm);
   EXPECT_EQ(out.lines[0].end_norm, in.lines[0].end_norm);
   EXPECT_EQ(out.lines[0].track_count, 4);
+  EXPECT_TRUE(out.lines[0].edge_checked);
   EXPECT_TRUE(out.lines[0].on_edge);
   EXPECT_EQ(out.lines[0].edge_start_norm, in.lines[0].edge_start_norm);
   EXPECT_EQ(out.lines[0].edge_end_norm, in.lines[0].edge_end_norm);

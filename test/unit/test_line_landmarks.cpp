@@ -124,6 +124,12 @@ TEST(LineLandmarks, RetirementSummaryNamesTheLimitsAndWarnsWhenMostTracksFailThe
   EXPECT_EQ(describeLineRetirement(c, 0.5, 0, 0.1),  // no edge positions (lines.map_edges off)
             "43 of 148 retired tracks; held back: 73 fit worse than 0.5 px RMS, 32 with cross "
             "parallax under 0.1");
+  c.held_back_edge = 9;
+  EXPECT_EQ(describeLineRetirement(c, 0.5, 0.35, 0.1),
+            "43 of 157 retired tracks; held back: 73 fit worse than 0.35 px RMS on their edges "
+            "(0.5 px on the tracker's positions), 32 with cross parallax under 0.1, 9 not found "
+            "on their edge at full resolution");
+  c.held_back_edge = 0;
   EXPECT_FALSE(fitLimitLooksTooTight(c));  // about half, as on the rendered benchmark
   c.held_back_fit = 300;                   // 300 of 375: 80 %
   EXPECT_TRUE(fitLimitLooksTooTight(c));
@@ -139,11 +145,13 @@ namespace {
 // `on_edge` frames, `edge_noise_px` up and down in turn.
 LineLandmark retireWithEdgePositions(int on_edge, const LineRetirementFilter& filter = {},
                                      double edge_noise_px = 0,
-                                     LineRetirementCounts* counts = nullptr) {
+                                     LineRetirementCounts* counts = nullptr,
+                                     bool checked_everywhere = false) {
   LineLandmarks lines(3, LineTriangulationOptions{});
   lines.setRetirementFilter(filter);
   for (int k = 0; k < 8; ++k) {
     auto obs = observeEdge(k, Eigen::Vector3d(0, 0, 0.03));
+    obs[0].edge_checked = checked_everywhere || k < on_edge;
     if (k < on_edge) {
       const Eigen::Vector2d noise(0, (k % 2 ? 1 : -1) * edge_noise_px / 458.0);
       obs[0].on_edge = true;
@@ -190,5 +198,16 @@ TEST(LineLandmarks, TracksOnTheirEdgesMeetTheEdgeFitLimit) {
   // A track fitted on the tracker's positions (too few on the edge) meets the other limit.
   filter.max_edge_reprojection_rms = 0;
   EXPECT_EQ(retireWithEdgePositions(3, filter, 0.4, &counts).track_observations, 8);
+  EXPECT_EQ(counts.retired, 1);
+}
+
+TEST(LineLandmarks, TracksWhoseEdgeWasLookedForButRarelyFoundStayOutOfTheMap) {
+  LineRetirementCounts counts;
+  // The edge looked for on all eight frames, found on three: held back.
+  EXPECT_EQ(retireWithEdgePositions(3, {}, 0, &counts, true).track_observations, 0);
+  EXPECT_EQ(counts.held_back_edge, 1);
+  EXPECT_EQ(counts.retired, 0);
+  // Found on four of eight: fitted on those.
+  EXPECT_EQ(retireWithEdgePositions(4, {}, 0, &counts, true).track_observations, 4);
   EXPECT_EQ(counts.retired, 1);
 }

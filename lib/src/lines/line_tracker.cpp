@@ -50,6 +50,7 @@ LineFrame LineTracker::trackUndistorted(const cv::Mat& undistorted, double t) {
     obs.start_norm = undistorter_.pixelToNormalised(obs.start_px);
     obs.end_norm = undistorter_.pixelToNormalised(obs.end_px);
     LineSegment edge(obs.start_px, obs.end_px);
+    obs.edge_checked = options_.map_edges;
     if (options_.map_edges && refineSegmentToEdge(undistorted, EdgeRefinementOptions(), &edge)) {
       obs.on_edge = true;
       obs.edge_start_norm = undistorter_.pixelToNormalised(edge.start);

@@ -35,7 +35,8 @@ struct LineRetirementCounts {
   int retired = 0;             ///< refined over their track and handed to the maps
   int held_back_fit = 0;       ///< track fits worse than max_reprojection_rms (or the edge one)
   int held_back_parallax = 0;  ///< fit fine, but under min_cross_parallax
-  int tracks() const { return retired + held_back_fit + held_back_parallax; }
+  int held_back_edge = 0;      ///< looked for on their full-resolution edge, found on under half
+  int tracks() const { return retired + held_back_fit + held_back_parallax + held_back_edge; }
 };
 
 /// "43 of 148 retired tracks; held back: 73 fit worse than 0.35 px RMS on their edges (0.5 px
@@ -89,6 +90,7 @@ class LineLandmarks {
     landmarks_.clear();
     history_.clear();
     edge_history_.clear();
+    edge_checks_.clear();
   }
   /// Lines retired since the last call, refined over their whole track (world frame).
   std::vector<LineLandmark> takeRetired();
@@ -103,7 +105,8 @@ class LineLandmarks {
   const std::map<int, LineLandmark>& landmarks() const { return landmarks_; }
 
  private:
-  void retire(const LineLandmark& l, const LineViews& views, const LineViews& edge_views);
+  void retire(const LineLandmark& l, const LineViews& views, const LineViews& edge_views,
+              int edge_checks);
   bool usableForRetirement(const LineLandmark& l, const LineViews& views) const;
 
   int min_observations_;
@@ -112,6 +115,7 @@ class LineLandmarks {
   std::map<int, LineLandmark> landmarks_;  // by id: deterministic order
   std::map<int, LineViews> history_;       // observations of frames that left the window
   std::map<int, LineViews> edge_history_;  // the same on their full-resolution edge, where found
+  std::map<int, int> edge_checks_;         // how many of those frames looked for the edge
   std::vector<LineLandmark> retired_;
   double sigma_ = 1.5 / 458.0;
   LineRetirementFilter filter_;

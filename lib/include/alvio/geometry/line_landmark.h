@@ -23,7 +23,8 @@ const char* toString(LineLandmarkStatus status);
 struct LineLandmarkObservation {
   Eigen::Vector2d start_norm = Eigen::Vector2d::Zero();
   Eigen::Vector2d end_norm = Eigen::Vector2d::Zero();
-  bool on_edge = false;  ///< the map's positions below are set (LineObservation::on_edge)
+  bool edge_checked = false;  ///< LineObservation::edge_checked
+  bool on_edge = false;       ///< the map's positions below are set (LineObservation::on_edge)
   Eigen::Vector2d edge_start_norm = Eigen::Vector2d::Zero();
   Eigen::Vector2d edge_end_norm = Eigen::Vector2d::Zero();
   EIGEN_MAKE_ALIGNED_OPERATOR_NEW
