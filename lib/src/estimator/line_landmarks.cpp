@@ -64,12 +64,13 @@ void LineLandmarks::removeFrame(int64_t frame_ns, const Eigen::Isometry3d* T_w_c
       v.T_w_c = *T_w_c;
       v.start_norm = obs->second.start_norm;
       v.end_norm = obs->second.end_norm;
-      history_[l.id].push_back(v);
-      edge_checks_[l.id] += obs->second.edge_checked;
+      TrackHistory& h = history_[l.id];
+      h.views.push_back(v);
+      h.edge_checks += obs->second.edge_checked;
       if (obs->second.on_edge) {
         v.start_norm = obs->second.edge_start_norm;
         v.end_norm = obs->second.edge_end_norm;
-        edge_history_[l.id].push_back(v);
+        h.edge_views.push_back(v);
       }
     }
     if (obs != l.observations.end()) l.observations.erase(obs);
@@ -77,27 +78,24 @@ void LineLandmarks::removeFrame(int64_t frame_ns, const Eigen::Isometry3d* T_w_c
       ++it;
       continue;
     }
-    retire(l, history_[l.id], edge_history_[l.id], edge_checks_[l.id]);
+    retire(l, history_[l.id]);
     history_.erase(l.id);
-    edge_history_.erase(l.id);
-    edge_checks_.erase(l.id);
     it = landmarks_.erase(it);
   }
 }
 
-void LineLandmarks::retire(const LineLandmark& l, const LineViews& all_views,
-                           const LineViews& edge_views, int edge_checks) {
+void LineLandmarks::retire(const LineLandmark& l, const TrackHistory& history) {
   // One refinement over every observation of the track, for the map: over those found on
   // their full-resolution edge (lines.map_edges) when they are at least half of the track.
   // The others are left out, not mixed in: the two positions differ by a few tenths of a
   // pixel, and tracks mixing them fitted worse (docs/benchmarks.md, eighteenth session).
-  const bool on_edges = 2 * edge_views.size() >= all_views.size();
-  const LineViews& views = on_edges ? edge_views : all_views;
+  const bool on_edges = 2 * history.edge_views.size() >= history.views.size();
+  const LineViews& views = on_edges ? history.edge_views : history.views;
   if (!usableForRetirement(l, views)) return;
   // Looked for on most frames but found on fewer than half: no single clean edge there, and
   // such tracks were the map's least precise (sim_MH_05: 77.7 % precision without them, 71.3 %
   // with them at the tracker's 0.5 px limit).
-  if (!on_edges && 2 * edge_checks >= static_cast<int>(all_views.size())) {
+  if (!on_edges && 2 * history.edge_checks >= static_cast<int>(history.views.size())) {
     ++counts_.held_back_edge;
     return;
   }

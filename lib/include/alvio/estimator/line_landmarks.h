@@ -89,8 +89,6 @@ class LineLandmarks {
   void clear() {
     landmarks_.clear();
     history_.clear();
-    edge_history_.clear();
-    edge_checks_.clear();
   }
   /// Lines retired since the last call, refined over their whole track (world frame).
   std::vector<LineLandmark> takeRetired();
@@ -105,17 +103,20 @@ class LineLandmarks {
   const std::map<int, LineLandmark>& landmarks() const { return landmarks_; }
 
  private:
-  void retire(const LineLandmark& l, const LineViews& views, const LineViews& edge_views,
-              int edge_checks);
+  /// A track's observations from frames that left the window, with their poses.
+  struct TrackHistory {
+    LineViews views;       ///< the tracker's positions
+    LineViews edge_views;  ///< the same on their full-resolution edge, where found
+    int edge_checks = 0;   ///< how many of those frames looked for the edge
+  };
+  void retire(const LineLandmark& l, const TrackHistory& history);
   bool usableForRetirement(const LineLandmark& l, const LineViews& views) const;
 
   int min_observations_;
   LineTriangulationOptions triangulation_;
   int last_tracked_ = 0;
   std::map<int, LineLandmark> landmarks_;  // by id: deterministic order
-  std::map<int, LineViews> history_;       // observations of frames that left the window
-  std::map<int, LineViews> edge_history_;  // the same on their full-resolution edge, where found
-  std::map<int, int> edge_checks_;         // how many of those frames looked for the edge
+  std::map<int, TrackHistory> history_;    // by id
   std::vector<LineLandmark> retired_;
   double sigma_ = 1.5 / 458.0;
   LineRetirementFilter filter_;
