@@ -39,7 +39,6 @@ PointTracker::PointTracker(const PointTrackerOptions& options,
 
 void PointTracker::reset() {
   prev_img_.release();
-  prev_pyramid_.clear();
   pts_.clear();
   ids_.clear();
   track_counts_.clear();
@@ -104,24 +103,17 @@ FeatureFrame PointTracker::track(const cv::Mat& gray, int64_t t_ns, FrameTiming*
 
   {
     ScopedStage stage(timing, "point_tracking");
-    // One pyramid (with its derivatives) per image, kept for the next frame: passing images
-    // made OpenCV rebuild both pyramids in each of the two KLT calls. Same flow to the bit.
-    const cv::Size win(options_.klt_window, options_.klt_window);
-    std::swap(pyramid_, prev_pyramid_);
-    cv::buildOpticalFlowPyramid(img, pyramid_, win, options_.klt_levels, true,
-                                cv::BORDER_REFLECT_101, cv::BORDER_CONSTANT,
-                                false);  // a copy: the caller may reuse img's buffer
     if (!prev_img_.empty() && !pts_.empty()) {
       std::vector<cv::Point2f> next;
       std::vector<uchar> status;
       std::vector<float> err;
-      cv::calcOpticalFlowPyrLK(prev_pyramid_, pyramid_, pts_, next, status, err, win,
-                               options_.klt_levels);
+      const cv::Size win(options_.klt_window, options_.klt_window);
+      cv::calcOpticalFlowPyrLK(prev_img_, img, pts_, next, status, err, win, options_.klt_levels);
       if (options_.forward_backward_check) {
         std::vector<cv::Point2f> back = pts_;
         std::vector<uchar> back_status;
         cv::calcOpticalFlowPyrLK(
-            pyramid_, prev_pyramid_, next, back, back_status, err, win, options_.klt_levels,
+            img, prev_img_, next, back, back_status, err, win, options_.klt_levels,
             cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 30, 0.01),
             cv::OPTFLOW_USE_INITIAL_FLOW);
         for (std::size_t i = 0; i < status.size(); ++i)

@@ -59,7 +59,6 @@ class PointTracker {
   cv::Ptr<cv::CLAHE> clahe_;
   CornerDetector corners_;
   cv::Mat prev_img_;
-  std::vector<cv::Mat> pyramid_, prev_pyramid_;  // KLT pyramids with derivatives
   int64_t prev_t_ns_ = 0;
   std::vector<cv::Point2f> pts_;
   std::vector<int> ids_, track_counts_;
