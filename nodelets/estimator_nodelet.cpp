@@ -396,9 +396,7 @@ class EstimatorNodelet : public GuardedNodelet {
     if (c.tracks() == 0) return;
     NODELET_INFO("lines for the map: %s",
                  alvio::describeLineRetirement(
-                     c, config_.estimator.line_map_max_rms_px,
-                     config_.lines.map_edges ? config_.estimator.line_map_max_edge_rms_px : 0.0,
-                     config_.estimator.line_map_min_parallax)
+                     c, alvio::lineMapLimits(config_.estimator, config_.lines.map_edges))
                      .c_str());
     if (alvio::fitLimitLooksTooTight(c)) NODELET_WARN("%s", alvio::kFitLimitHint);
   }

@@ -116,10 +116,8 @@ int main(int argc, char** argv) {
     const LineRetirementCounts& lr = r.line_retirement;
     if (lr.tracks() > 0)
       std::cout << "lines for the maps: "
-                << describeLineRetirement(
-                       lr, config.estimator.line_map_max_rms_px,
-                       config.lines.map_edges ? config.estimator.line_map_max_edge_rms_px : 0.0,
-                       config.estimator.line_map_min_parallax)
+                << describeLineRetirement(lr,
+                                          lineMapLimits(config.estimator, config.lines.map_edges))
                 << "\n";
     if (fitLimitLooksTooTight(lr)) std::cout << "note: " << kFitLimitHint << "\n";
     std::cout << r.timing.summaryTable();

@@ -113,22 +113,62 @@ TEST(LineLandmarks, RetirementFilterNeedsCameraMotionAcrossTheLine) {
   EXPECT_EQ(counts.retired + counts.held_back_fit, 0);
 }
 
+TEST(LineLandmarks, RetirementFilterHoldsBackLinesPlacedLessCertainlyThanTheLimit) {
+  // The slide's 8 views at the estimator's 1.5 px noise, the poses taken as exact.
+  const double sigma = 1.5 / 458.0;
+  LineViews views;
+  for (int k = 0; k < 8; ++k) {
+    LineView v;
+    v.T_w_c = cameraAt(k);
+    v.start_norm = projectNormalised(v.T_w_c, kP);
+    v.end_norm = projectNormalised(v.T_w_c, kQ);
+    views.push_back(v);
+  }
+  const LineUncertainty u =
+      lineUncertainty(PluckerLine::fromPoints(kP, kQ), 0.5 * (kP + kQ), views, sigma);
+  ASSERT_GT(u.midpoint_std_m, 1e-3);
+  ASSERT_LT(u.midpoint_std_m, 0.5);
+  LineRetirementFilter filter;
+  filter.max_midpoint_std_m = 1.1 * u.midpoint_std_m;
+  LineRetirementCounts counts;
+  const std::vector<LineLandmark> retired = slideThrough(0, filter, 8, &counts);
+  ASSERT_EQ(retired.size(), 1u);
+  EXPECT_NEAR(retired[0].midpoint_std_m, u.midpoint_std_m, 1e-3 * u.midpoint_std_m);
+  filter.max_midpoint_std_m = 0.9 * u.midpoint_std_m;
+  EXPECT_TRUE(slideThrough(0, filter, 8, &counts).empty());
+  EXPECT_EQ(counts.held_back_uncertain, 1);
+  EXPECT_EQ(counts.retired + counts.held_back_fit + counts.held_back_parallax, 0);
+}
+
 TEST(LineLandmarks, RetirementSummaryNamesTheLimitsAndWarnsWhenMostTracksFailTheFit) {
   LineRetirementCounts c;
   c.retired = 43;
   c.held_back_fit = 73;
   c.held_back_parallax = 32;
-  EXPECT_EQ(describeLineRetirement(c, 0.5, 0.35, 0.1),
+  LineMapLimits limits;
+  limits.max_rms_px = 0.5;
+  limits.max_edge_rms_px = 0.35;
+  limits.min_parallax = 0.1;
+  EXPECT_EQ(describeLineRetirement(c, limits),
             "43 of 148 retired tracks; held back: 73 fit worse than 0.35 px RMS on their edges "
             "(0.5 px on the tracker's positions), 32 with cross parallax under 0.1");
-  EXPECT_EQ(describeLineRetirement(c, 0.5, 0, 0.1),  // no edge positions (lines.map_edges off)
+  LineMapLimits no_edges = limits;  // lines.map_edges off
+  no_edges.max_edge_rms_px = 0;
+  EXPECT_EQ(describeLineRetirement(c, no_edges),
             "43 of 148 retired tracks; held back: 73 fit worse than 0.5 px RMS, 32 with cross "
             "parallax under 0.1");
   c.held_back_edge = 9;
-  EXPECT_EQ(describeLineRetirement(c, 0.5, 0.35, 0.1),
+  EXPECT_EQ(describeLineRetirement(c, limits),
             "43 of 157 retired tracks; held back: 73 fit worse than 0.35 px RMS on their edges "
             "(0.5 px on the tracker's positions), 32 with cross parallax under 0.1, 9 not found "
             "on their edge at full resolution");
+  c.held_back_uncertain = 5;
+  limits.max_midpoint_std_m = 0.03;
+  EXPECT_EQ(describeLineRetirement(c, limits),
+            "43 of 162 retired tracks; held back: 73 fit worse than 0.35 px RMS on their edges "
+            "(0.5 px on the tracker's positions), 32 with cross parallax under 0.1, 9 not found "
+            "on their edge at full resolution, 5 placed less certainly than 3 cm (1 sigma)");
+  c.held_back_uncertain = 0;
   c.held_back_edge = 0;
   EXPECT_FALSE(fitLimitLooksTooTight(c));  // about half, as on the rendered benchmark
   c.held_back_fit = 300;                   // 300 of 375: 80 %

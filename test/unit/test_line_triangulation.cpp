@@ -309,3 +309,50 @@ TEST(LineQuality, CrossParallaxCountsOnlyMotionAcrossTheLine) {
   // A single view has no parallax.
   EXPECT_EQ(lineCrossParallax(P, Q, viewsFrom({{0, 0, 0}})), 0.0);
 }
+
+TEST(LineQuality, UncertaintyPredictsTheSpreadOfRefinedLines) {
+  // Monte Carlo: the spread of lines refined from noisy views matches the predicted 1-sigma
+  // uncertainty of the direction and of the midpoint's position across the line.
+  const double noise = 1.0 / 458.0;
+  const PluckerLine truth = PluckerLine::fromPoints(kP, kQ);
+  const Eigen::Vector3d mid = 0.5 * (kP + kQ);
+  std::mt19937 clean(7);
+  const LineUncertainty predicted = lineUncertainty(truth, mid, sweep(0.0, clean), noise);
+  double angle2 = 0, distance2 = 0;
+  const int trials = 300;
+  for (int k = 0; k < trials; ++k) {
+    std::mt19937 rng(500 + k);
+    PluckerLine line;
+    ASSERT_EQ(triangulateLineMultiView(sweep(noise, rng), {}, &line), LineTriangulationStatus::kOk);
+    angle2 += std::pow(lineAngle(line, truth) * kRadToDeg, 2);
+    distance2 += std::pow(line.distanceTo(mid), 2);
+  }
+  const double angle_rms = std::sqrt(angle2 / trials);
+  const double distance_rms = std::sqrt(distance2 / trials);
+  RecordProperty("predicted_midpoint_std_m", std::to_string(predicted.midpoint_std_m));
+  RecordProperty("measured_midpoint_rms_m", std::to_string(distance_rms));
+  EXPECT_NEAR(distance_rms / predicted.midpoint_std_m, 1.0, 0.15);
+  EXPECT_NEAR(angle_rms / predicted.direction_std_deg, 1.0, 0.15);
+}
+
+TEST(LineQuality, MidpointUncertaintyGrowsWithDepthAndFallsWithBaseline) {
+  std::mt19937 rng(8);
+  const double noise = 1.0 / 458.0;
+  const auto stdAt = [&](double depth_scale, double baseline_scale) {
+    // The whole scene scaled about the first camera, the camera path scaled on its own.
+    const Eigen::Vector3d P = depth_scale * kP, Q = depth_scale * kQ;
+    LineViews views;
+    for (int i = 0; i < 8; ++i) {
+      const Eigen::Vector3d position =
+          baseline_scale * Eigen::Vector3d(0.05 * std::sin(i), 0.3 - 0.06 * i, -0.4 + 0.12 * i);
+      views.push_back(observe(lookAt(position, 0.5 * (P + Q)), P, Q, 0, 1, 0, rng));
+    }
+    return lineUncertainty(PluckerLine::fromPoints(P, Q), 0.5 * (P + Q), views, noise)
+        .midpoint_std_m;
+  };
+  const double base = stdAt(1, 1);
+  EXPECT_GT(stdAt(2, 1), 2 * base);  // depth error grows with the square of the distance
+  EXPECT_LT(stdAt(1, 2), 0.6 * base);
+  // Views all from one place: the depth is unobservable.
+  EXPECT_GT(stdAt(1, 1e-6), 1e3 * base);
+}

@@ -31,6 +31,8 @@ Estimator::Estimator(const EstimatorOptions& options, const CameraOptions& camer
   if (options.line_map_max_edge_rms_px > 0)
     filter.max_edge_reprojection_rms = options.line_map_max_edge_rms_px / camera.intrinsics[0];
   filter.min_cross_parallax = options.line_map_min_parallax;
+  if (options.line_map_max_midpoint_std_m > 0)
+    filter.max_midpoint_std_m = options.line_map_max_midpoint_std_m;
   lines_.setRetirementFilter(filter);
   clearState();
 }

@@ -40,6 +40,8 @@ EstimatorOptions EstimatorOptions::load(const YamlReader& yaml, const std::strin
   o.line_map_min_parallax = yaml.getDouble(p + "line_map_min_parallax", o.line_map_min_parallax);
   o.line_map_max_edge_rms_px =
       yaml.getDouble(p + "line_map_max_edge_rms_px", o.line_map_max_edge_rms_px);
+  o.line_map_max_midpoint_std_m =
+      yaml.getDouble(p + "line_map_max_midpoint_std_m", o.line_map_max_midpoint_std_m);
   o.selection = FeatureSelectionOptions::load(yaml, p + "selection");
   o.init_min_parallax_px = yaml.getDouble(p + "init_min_parallax_px", o.init_min_parallax_px);
   o.init_relaxed_parallax_px =
@@ -80,6 +82,15 @@ EstimatorOptions EstimatorOptions::load(const YamlReader& yaml, const std::strin
     throw Error(yaml.where(p + "robust_loss") + ": unknown loss '" + o.robust_loss +
                 "' (expected cauchy, huber or none)");
   return o;
+}
+
+LineMapLimits lineMapLimits(const EstimatorOptions& options, bool edge_positions) {
+  LineMapLimits limits;
+  limits.max_rms_px = options.line_map_max_rms_px;
+  limits.max_edge_rms_px = edge_positions ? options.line_map_max_edge_rms_px : 0.0;
+  limits.min_parallax = options.line_map_min_parallax;
+  limits.max_midpoint_std_m = options.line_map_max_midpoint_std_m;
+  return limits;
 }
 
 }  // namespace alvio

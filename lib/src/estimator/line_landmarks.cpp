@@ -1,29 +1,28 @@
 #include "alvio/estimator/line_landmarks.h"
 
-#include <Eigen/LU>
 #include <cmath>
 #include <sstream>
 
-#include "alvio/geometry/line_projection_factor.h"
 #include "alvio/geometry/line_quality.h"
-#include "alvio/geometry/orthonormal_line.h"
-#include "alvio/geometry/orthonormal_line_manifold.h"
 
 namespace alvio {
 
-std::string describeLineRetirement(const LineRetirementCounts& counts, double max_rms_px,
-                                   double max_edge_rms_px, double min_parallax) {
+std::string describeLineRetirement(const LineRetirementCounts& counts,
+                                   const LineMapLimits& limits) {
   std::ostringstream os;
   os << counts.retired << " of " << counts.tracks()
      << " retired tracks; held back: " << counts.held_back_fit << " fit worse than ";
-  if (max_edge_rms_px > 0)
-    os << max_edge_rms_px << " px RMS on their edges (" << max_rms_px
+  if (limits.max_edge_rms_px > 0)
+    os << limits.max_edge_rms_px << " px RMS on their edges (" << limits.max_rms_px
        << " px on the tracker's positions), ";
   else
-    os << max_rms_px << " px RMS, ";
-  os << counts.held_back_parallax << " with cross parallax under " << min_parallax;
+    os << limits.max_rms_px << " px RMS, ";
+  os << counts.held_back_parallax << " with cross parallax under " << limits.min_parallax;
   if (counts.held_back_edge > 0)
     os << ", " << counts.held_back_edge << " not found on their edge at full resolution";
+  if (limits.max_midpoint_std_m > 0)
+    os << ", " << counts.held_back_uncertain << " placed less certainly than "
+       << 100 * limits.max_midpoint_std_m << " cm (1 sigma)";
   return os.str();
 }
 
@@ -112,13 +111,19 @@ void LineLandmarks::retire(const LineLandmark& l, const TrackHistory& history) {
     ++counts_.held_back_parallax;
     return;
   }
+  const LineUncertainty uncertainty = lineUncertainty(line, 0.5 * (a + b), views, sigma_);
+  if (uncertainty.midpoint_std_m > filter_.max_midpoint_std_m) {
+    ++counts_.held_back_uncertain;
+    return;
+  }
   ++counts_.retired;
   LineLandmark retired = l;
   retired.setLine(line, LineLandmarkStatus::kOptimised);
   retired.start_w = a;
   retired.end_w = b;
   retired.has_extent = true;
-  retired.direction_std_deg = directionStdDeg(line, views, sigma_);
+  retired.direction_std_deg = uncertainty.direction_std_deg;
+  retired.midpoint_std_m = uncertainty.midpoint_std_m;
   retired.track_observations = static_cast<int>(views.size());
   retired_.push_back(retired);
 }
@@ -132,34 +137,6 @@ std::vector<LineLandmark> LineLandmarks::takeRetired() {
   std::vector<LineLandmark> out;
   out.swap(retired_);
   return out;
-}
-
-double LineLandmarks::directionStdDeg(const PluckerLine& line, const LineViews& views,
-                                      double sigma) {
-  // Information of the line from the views (poses fixed), whitened by sigma; the tangent
-  // components dtheta_x and dtheta_z of the orthonormal representation turn the direction.
-  double x[4];
-  OrthonormalLine::fromPlucker(line).toParameters(x);
-  Eigen::Matrix<double, 4, 4, Eigen::RowMajor> plus_jacobian;
-  OrthonormalLineManifold().PlusJacobian(x, plus_jacobian.data());
-  Eigen::Matrix4d H = Eigen::Matrix4d::Zero();
-  for (const auto& v : views) {
-    const LineProjectionFactor f(v.start_norm, v.end_norm, Eigen::Isometry3d::Identity(),
-                                 1.0 / sigma);
-    double pose[7];
-    poseToParameters(v.T_w_c, pose);
-    const double* params[] = {pose, x};
-    Eigen::Vector2d r;
-    Eigen::Matrix<double, 2, 4, Eigen::RowMajor> J;
-    double* jacobians[] = {nullptr, J.data()};
-    if (!f.Evaluate(params, r.data(), jacobians)) continue;
-    const Eigen::Matrix<double, 2, 4> Jt = J * plus_jacobian;
-    H += Jt.transpose() * Jt;
-  }
-  const Eigen::FullPivLU<Eigen::Matrix4d> lu(H);
-  if (!lu.isInvertible()) return 180.0;
-  const Eigen::Matrix4d C = lu.inverse();
-  return std::sqrt(std::max(0.0, C(0, 0) + C(2, 2))) * 180.0 / M_PI;
 }
 
 namespace {

@@ -1,9 +1,14 @@
 #include "alvio/geometry/line_quality.h"
 
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <vector>
+
+#include "alvio/geometry/line_projection_factor.h"
+#include "alvio/geometry/orthonormal_line.h"
+#include "alvio/geometry/orthonormal_line_manifold.h"
 
 namespace alvio {
 
@@ -60,6 +65,57 @@ double lineCrossParallax(const Eigen::Vector3d& start_w, const Eigen::Vector3d& 
   auto median = distances.begin() + static_cast<std::ptrdiff_t>(distances.size() / 2);
   std::nth_element(distances.begin(), median, distances.end());
   return *median > 0 ? (hi - lo) / *median : 0;
+}
+
+LineUncertainty lineUncertainty(const PluckerLine& line_w, const Eigen::Vector3d& midpoint_w,
+                                const LineViews& views, double sigma) {
+  // Information of the four tangent parameters of the orthonormal representation, whitened by
+  // sigma; its inverse is their covariance.
+  double x[4];
+  OrthonormalLine::fromPlucker(line_w).toParameters(x);
+  const OrthonormalLineManifold manifold;
+  Eigen::Matrix<double, 4, 4, Eigen::RowMajor> plus_jacobian;
+  manifold.PlusJacobian(x, plus_jacobian.data());
+  Eigen::Matrix4d H = Eigen::Matrix4d::Zero();
+  for (const auto& v : views) {
+    const LineProjectionFactor f(v.start_norm, v.end_norm, Eigen::Isometry3d::Identity(),
+                                 1.0 / sigma);
+    double pose[7];
+    poseToParameters(v.T_w_c, pose);
+    const double* params[] = {pose, x};
+    Eigen::Vector2d r;
+    Eigen::Matrix<double, 2, 4, Eigen::RowMajor> J;
+    double* jacobians[] = {nullptr, J.data()};
+    if (!f.Evaluate(params, r.data(), jacobians)) continue;
+    const Eigen::Matrix<double, 2, 4> Jt = J * plus_jacobian;
+    H += Jt.transpose() * Jt;
+  }
+  LineUncertainty u;
+  const Eigen::FullPivLU<Eigen::Matrix4d> lu(H);
+  if (!lu.isInvertible()) return u;
+  const Eigen::Matrix4d C = lu.inverse();
+  // dtheta_x and dtheta_z turn the direction.
+  u.direction_std_deg = std::sqrt(std::max(0.0, C(0, 0) + C(2, 2))) * 180.0 / M_PI;
+  // How the line's point nearest the midpoint moves with each tangent step (central
+  // differences; the step is small against any line a camera resolves).
+  const auto nearest = [&](const double* xp) {
+    const PluckerLine l = pluckerFromParameters(xp);
+    const Eigen::Vector3d d = l.d.normalized();
+    const Eigen::Vector3d p = l.closestPointToOrigin();
+    return Eigen::Vector3d(p + d * d.dot(midpoint_w - p));
+  };
+  Eigen::Matrix<double, 3, 4> Jm;
+  const double h = 1e-6;
+  for (int k = 0; k < 4; ++k) {
+    double step[4] = {0, 0, 0, 0}, plus[4], minus[4];
+    step[k] = h;
+    manifold.Plus(x, step, plus);
+    step[k] = -h;
+    manifold.Plus(x, step, minus);
+    Jm.col(k) = (nearest(plus) - nearest(minus)) / (2 * h);
+  }
+  u.midpoint_std_m = std::sqrt(std::max(0.0, (Jm * C * Jm.transpose()).trace()));
+  return u;
 }
 
 }  // namespace alvio

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "alvio/estimator/feature_selection.h"
+#include "alvio/estimator/line_landmarks.h"
 #include "alvio/geometry/line_triangulation.h"
 
 namespace alvio {
@@ -45,6 +46,9 @@ struct EstimatorOptions {
   /// The RMS limit for a track fitted on its full-resolution edge positions (lines.map_edges).
   double line_map_max_edge_rms_px = 0.35;
   double line_map_min_parallax = 0.10;
+  /// Largest 1-sigma uncertainty of a map line's midpoint across the line [m], from its whole
+  /// track at line_sigma_px with the poses taken as exact (<= 0: no limit).
+  double line_map_max_midpoint_std_m = 0.03;
 
   /// Sensitivity-based selection and adaptive weighting (estimator.selection).
   FeatureSelectionOptions selection;
@@ -77,5 +81,8 @@ struct EstimatorOptions {
 
   static EstimatorOptions load(const YamlReader& yaml, const std::string& prefix);
 };
+
+/// The map limits that apply, for run summaries: the edge fit limit only with edge positions.
+LineMapLimits lineMapLimits(const EstimatorOptions& options, bool edge_positions);
 
 }  // namespace alvio

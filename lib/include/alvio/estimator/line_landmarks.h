@@ -28,22 +28,35 @@ struct LineRetirementFilter {
   double max_edge_reprojection_rms = std::numeric_limits<double>::infinity();
   /// Smallest cross parallax (lineCrossParallax: baseline across the line over distance).
   double min_cross_parallax = 0;
+  /// Largest 1-sigma position uncertainty of the segment's midpoint across the line [m]
+  /// (lineUncertainty at the estimator's line noise).
+  double max_midpoint_std_m = std::numeric_limits<double>::infinity();
 };
 
 /// What became of the lines that left the window with enough observations and an extent.
 struct LineRetirementCounts {
-  int retired = 0;             ///< refined over their track and handed to the maps
-  int held_back_fit = 0;       ///< track fits worse than max_reprojection_rms (or the edge one)
-  int held_back_parallax = 0;  ///< fit fine, but under min_cross_parallax
-  int held_back_edge = 0;      ///< looked for on their full-resolution edge, found on under half
-  int tracks() const { return retired + held_back_fit + held_back_parallax + held_back_edge; }
+  int retired = 0;              ///< refined over their track and handed to the maps
+  int held_back_fit = 0;        ///< track fits worse than max_reprojection_rms (or the edge one)
+  int held_back_parallax = 0;   ///< fit fine, but under min_cross_parallax
+  int held_back_edge = 0;       ///< looked for on their full-resolution edge, found on under half
+  int held_back_uncertain = 0;  ///< passed the rest, midpoint less certain than max_midpoint_std_m
+  int tracks() const {
+    return retired + held_back_fit + held_back_parallax + held_back_edge + held_back_uncertain;
+  }
+};
+
+/// The map limits as configured, in the units a user sets them, for run summaries.
+struct LineMapLimits {
+  double max_rms_px = 0;
+  double max_edge_rms_px = 0;  ///< <= 0 when there are no edge positions (lines.map_edges off)
+  double min_parallax = 0;
+  double max_midpoint_std_m = 0;  ///< <= 0: no limit
 };
 
 /// "43 of 148 retired tracks; held back: 73 fit worse than 0.35 px RMS on their edges (0.5 px
-/// on the tracker's positions), 32 with cross parallax under 0.1" (the limits as configured;
-/// max_edge_rms_px <= 0 when there are no edge positions), for run summaries and logs.
-std::string describeLineRetirement(const LineRetirementCounts& counts, double max_rms_px,
-                                   double max_edge_rms_px, double min_parallax);
+/// on the tracker's positions), 32 with cross parallax under 0.1, ..." (the limits as
+/// configured), for run summaries and logs.
+std::string describeLineRetirement(const LineRetirementCounts& counts, const LineMapLimits& limits);
 /// Over three quarters of at least kMinTracksToJudgeTheFitLimit tracks fail the fit limit. On
 /// the whole of sim_MH_05, 393 of 1206 (33 %) do (fourteenth session); a camera whose line
 /// endpoints are much noisier fails nearly all and needs a looser limit.
@@ -92,8 +105,6 @@ class LineLandmarks {
   }
   /// Lines retired since the last call, refined over their whole track (world frame).
   std::vector<LineLandmark> takeRetired();
-  /// Direction uncertainty [deg] of a line from views (residual noise sigma in normalised units).
-  static double directionStdDeg(const PluckerLine& line, const LineViews& views, double sigma);
   void setObservationSigma(double sigma_normalised) { sigma_ = sigma_normalised; }
   void setRetirementFilter(const LineRetirementFilter& filter) { filter_ = filter; }
   /// Since construction (resets included).

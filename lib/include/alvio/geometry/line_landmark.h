@@ -45,6 +45,9 @@ struct LineLandmark {
   /// 1-sigma uncertainty of the line's direction from its window observations [deg]
   /// (negative until computed). Lines seen with little parallax are poorly constrained.
   double direction_std_deg = -1;
+  /// 1-sigma uncertainty of the extent's midpoint across the line [m] over the whole track
+  /// (set when the line retires; negative before).
+  double midpoint_std_m = -1;
   /// Observations over the whole track (set when the line retires from the window).
   int track_observations = 0;
 

@@ -5,6 +5,7 @@
 // it (or from far away) is placed by noise. Used to keep such lines out of the maps.
 
 #include <Eigen/Core>
+#include <limits>
 
 #include "alvio/geometry/line_triangulation.h"
 #include "alvio/geometry/plucker_line.h"
@@ -29,5 +30,16 @@ double lineReprojectionRms(const PluckerLine& line_w, const LineViews& views);
 /// dimensionless baseline-over-depth; motion along the line or the ray adds nothing.
 double lineCrossParallax(const Eigen::Vector3d& start_w, const Eigen::Vector3d& end_w,
                          const LineViews& views);
+
+/// 1-sigma uncertainty of a line fitted to its views, from the information of the views'
+/// endpoint-distance residuals at noise `sigma` (normalised units), the poses taken as exact.
+struct LineUncertainty {
+  double direction_std_deg = 180;  ///< of the direction
+  /// Of the point of the line nearest `midpoint_w`, across the line [m]. Grows with depth and
+  /// with too little motion across the line, the two things that put a map line off its edge.
+  double midpoint_std_m = std::numeric_limits<double>::infinity();
+};
+LineUncertainty lineUncertainty(const PluckerLine& line_w, const Eigen::Vector3d& midpoint_w,
+                                const LineViews& views, double sigma);
 
 }  // namespace alvio
