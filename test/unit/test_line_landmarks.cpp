@@ -140,6 +140,29 @@ TEST(LineLandmarks, RetirementFilterHoldsBackLinesPlacedLessCertainlyThanTheLimi
   EXPECT_EQ(counts.retired + counts.held_back_fit + counts.held_back_parallax, 0);
 }
 
+TEST(LineLandmarks, ALandmarkRecreatedUnderARemovedIdStartsANewHistory) {
+  // The tracker keeps a line's id after the estimator removed it as an outlier; the new
+  // landmark's map fit must not include the views the old one had already passed on.
+  LineLandmarks lines(3, LineTriangulationOptions{});
+  const auto pose = [](int64_t ns) { return cameraAt(static_cast<int>(ns - 1000)); };
+  for (int k = 0; k < 4; ++k) lines.addFrame(stamp(k), observeEdge(k));
+  lines.triangulate(pose);
+  for (int k = 0; k < 2; ++k) {
+    const Eigen::Isometry3d T = cameraAt(k);
+    lines.removeFrame(stamp(k), &T);  // two views into the history
+  }
+  lines.removeIds({3});
+  for (int k = 4; k < 8; ++k) lines.addFrame(stamp(k), observeEdge(k));
+  lines.triangulate(pose);
+  for (int k = 4; k < 8; ++k) {
+    const Eigen::Isometry3d T = cameraAt(k);
+    lines.removeFrame(stamp(k), &T);
+  }
+  const std::vector<LineLandmark> retired = lines.takeRetired();
+  ASSERT_EQ(retired.size(), 1u);
+  EXPECT_EQ(retired[0].track_observations, 4);
+}
+
 TEST(LineLandmarks, RetirementSummaryNamesTheLimitsAndWarnsWhenMostTracksFailTheFit) {
   LineRetirementCounts c;
   c.retired = 43;

@@ -186,7 +186,12 @@ int LineLandmarks::usableCount() const {
 }
 
 void LineLandmarks::removeIds(const std::vector<int>& ids) {
-  for (int id : ids) landmarks_.erase(id);
+  // The history goes too: the tracker keeps the id, and a landmark re-created under it must
+  // not inherit the views that made this one an outlier (nor keep them forever if it is not).
+  for (int id : ids) {
+    landmarks_.erase(id);
+    history_.erase(id);
+  }
 }
 
 }  // namespace alvio
