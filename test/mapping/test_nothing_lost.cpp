@@ -90,6 +90,10 @@ void expectCompleteOutputs(const std::string& out) {
     EXPECT_TRUE(fs::exists(fs::path(out) / f)) << f;
   const auto summary = nlohmann::json::parse(test::readFile(out + "/summary.json"));
   const std::size_t frames = summary["frames"];
+  // What the map filter did with the line tracks, one count per reason.
+  for (const char* k : {"lines_retired", "lines_held_back_fit", "lines_held_back_parallax",
+                        "lines_held_back_edge", "lines_held_back_uncertain"})
+    EXPECT_TRUE(summary.contains(k)) << k;
   // timing.csv: a header and a row per processed frame.
   const std::string timing = test::readFile(out + "/timing.csv");
   EXPECT_EQ(static_cast<std::size_t>(std::count(timing.begin(), timing.end(), '\n')), frames + 1);

@@ -236,6 +236,8 @@ RunResult runOffline(SensorSource& source, const Config& config, const RunOption
   summary["lines_retired"] = result.line_retirement.retired;
   summary["lines_held_back_fit"] = result.line_retirement.held_back_fit;
   summary["lines_held_back_parallax"] = result.line_retirement.held_back_parallax;
+  summary["lines_held_back_edge"] = result.line_retirement.held_back_edge;
+  summary["lines_held_back_uncertain"] = result.line_retirement.held_back_uncertain;
   summary["interrupted"] = result.interrupted;
   for (const auto& s : result.timing.summary())
     summary["timing_ms"][s.stage] = {
