@@ -179,6 +179,7 @@ void toMsg(const alvio::KeyframeLandmarks& keyframe, uint8_t kind, const std_msg
     m.end = toPoint(l.p1_w);
     m.observations = l.observations;
     m.direction_std_deg = l.direction_std_deg;
+    m.midpoint_std_m = l.midpoint_std_m;
   }
 }
 
@@ -189,8 +190,8 @@ alvio::KeyframeLandmarks fromMsg(const alvio::MapKeyframe& msg) {
   for (const auto& p : msg.points)
     kf.points.push_back({p.id, fromPoint(p.position), p.parallax_deg});
   for (const auto& l : msg.lines)
-    kf.lines.push_back(
-        {l.id, fromPoint(l.start), fromPoint(l.end), l.observations, l.direction_std_deg});
+    kf.lines.push_back({l.id, fromPoint(l.start), fromPoint(l.end), l.observations,
+                        l.direction_std_deg, l.midpoint_std_m});
   return kf;
 }
 

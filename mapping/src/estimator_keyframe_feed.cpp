@@ -46,7 +46,8 @@ KeyframeLandmarks retiredLinesKeyframe(const BodyState& state, const Eigen::Isom
   kf.t = state.t;
   kf.T_w_c = Eigen::Translation3d(state.p) * state.q * T_b_c;
   for (const LineSegment3& l : retired)
-    kf.lines.push_back({l.id, l.start, l.end, l.observations, l.direction_std_deg});
+    kf.lines.push_back(
+        {l.id, l.start, l.end, l.observations, l.direction_std_deg, l.midpoint_std_m});
   return kf;
 }
 

@@ -44,7 +44,7 @@ LineMap::LineMap(const LineMapOptions& options)
     : options_(options), cos_merge_angle_(std::cos(options.merge_angle_deg * M_PI / 180.0)) {}
 
 bool LineMap::addSegment(int id, const Eigen::Vector3d& p0_w, const Eigen::Vector3d& p1_w,
-                         int observations, const Eigen::Vector3d& camera_w) {
+                         int observations, const Eigen::Vector3d& camera_w, double midpoint_std_m) {
   const double len = (p1_w - p0_w).norm();
   if (!p0_w.allFinite() || !p1_w.allFinite() || !(len > 1e-9)) return false;
   Member m;
@@ -54,6 +54,7 @@ bool LineMap::addSegment(int id, const Eigen::Vector3d& p0_w, const Eigen::Vecto
   m.observations = std::max(1, observations);
   m.min_depth = camera_w.allFinite() ? pointSegmentDistance(camera_w, p0_w, p1_w)
                                      : std::numeric_limits<double>::infinity();
+  m.midpoint_std_m = midpoint_std_m;
   m.stamp = ++stamp_;
 
   int key = -1, home = -1;
@@ -161,6 +162,7 @@ void LineMap::fit(Line* line) {
   line->observations = 0;
   line->landmarks = 0;
   line->min_depth = std::numeric_limits<double>::infinity();
+  line->midpoint_std_m = -1;
   for (const Member& m : line->members) {
     for (const Eigen::Vector3d& p : {m.p0, m.p1}) {
       t0 = std::min(t0, (p - c).dot(u));
@@ -169,6 +171,9 @@ void LineMap::fit(Line* line) {
     line->observations += m.observations;
     line->landmarks += m.landmarks;
     line->min_depth = std::min(line->min_depth, m.min_depth);
+    if (m.midpoint_std_m >= 0 &&
+        (line->midpoint_std_m < 0 || m.midpoint_std_m < line->midpoint_std_m))
+      line->midpoint_std_m = m.midpoint_std_m;
   }
   line->c = c;
   line->u = u;
@@ -194,6 +199,7 @@ void LineMap::foldOldMembers(Line* line) {
   folded.observations = old.observations;
   folded.landmarks = old.landmarks;
   folded.min_depth = old.min_depth;
+  folded.midpoint_std_m = old.midpoint_std_m;
   folded.stamp = old.members.back().stamp;
   for (const Member& m : old.members)
     if (m.id >= 0) line_of_id_.erase(m.id);
@@ -320,6 +326,7 @@ MapLine LineMap::toMapLine(const Line& line) const {
   out.observations = line.observations;
   out.landmarks = line.landmarks;
   out.min_depth_m = line.min_depth;
+  out.midpoint_std_m = line.midpoint_std_m;
   return out;
 }
 

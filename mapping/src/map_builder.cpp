@@ -69,7 +69,7 @@ void MapBuilder::addKeyframe(const KeyframeLandmarks& keyframe) {
     kept.points.push_back(p);
   }
   for (const LandmarkSegment& l : kept.lines)
-    lines_.addSegment(l.id, l.p0_w, l.p1_w, l.observations, camera);
+    lines_.addSegment(l.id, l.p0_w, l.p1_w, l.observations, camera, l.midpoint_std_m);
   occupancy_.insertKeyframe(kept);
 }
 

@@ -25,11 +25,14 @@ std::string linesToPly(const std::vector<MapLine>& lines) {
      << "comment edge id: map line ID (as in lines.csv)\n"
      << "comment edge observations: image observations summed over merged landmarks\n"
      << "comment edge landmarks: number of landmark IDs merged into the line\n"
+     << "comment edge midpoint_std_m: 1-sigma midpoint uncertainty across the line of its "
+        "best-placed landmark (m), -1 when unknown\n"
      << "element vertex " << 2 * lines.size() << "\n"
      << "property float x\nproperty float y\nproperty float z\n"
      << "element edge " << lines.size() << "\n"
      << "property int vertex1\nproperty int vertex2\n"
      << "property int id\nproperty int observations\nproperty int landmarks\n"
+     << "property float midpoint_std_m\n"
      << "end_header\n";
   os << std::setprecision(9);
   for (const MapLine& l : lines) {
@@ -38,16 +41,18 @@ std::string linesToPly(const std::vector<MapLine>& lines) {
   }
   for (std::size_t i = 0; i < lines.size(); ++i)
     os << 2 * i << " " << 2 * i + 1 << " " << lines[i].id << " " << lines[i].observations << " "
-       << lines[i].landmarks << "\n";
+       << lines[i].landmarks << " " << lines[i].midpoint_std_m << "\n";
   return os.str();
 }
 
 std::string linesToCsv(const std::vector<MapLine>& lines) {
   std::ostringstream os;
-  os << "id,x0,y0,z0,x1,y1,z1,observations,landmarks\n" << std::fixed << std::setprecision(6);
+  os << "id,x0,y0,z0,x1,y1,z1,observations,landmarks,midpoint_std_m\n"
+     << std::fixed << std::setprecision(6);
   for (const MapLine& l : lines)
     os << l.id << "," << l.p0.x() << "," << l.p0.y() << "," << l.p0.z() << "," << l.p1.x() << ","
-       << l.p1.y() << "," << l.p1.z() << "," << l.observations << "," << l.landmarks << "\n";
+       << l.p1.y() << "," << l.p1.z() << "," << l.observations << "," << l.landmarks << ","
+       << l.midpoint_std_m << "\n";
   return os.str();
 }
 
@@ -65,9 +70,14 @@ std::vector<MapLine> readLinesCsv(const std::string& path) {
     char c[8];
     is >> l.id >> c[0] >> l.p0.x() >> c[1] >> l.p0.y() >> c[2] >> l.p0.z() >> c[3] >> l.p1.x() >>
         c[4] >> l.p1.y() >> c[5] >> l.p1.z() >> c[6] >> l.observations >> c[7] >> l.landmarks;
-    if (!is || std::string(c, 8) != ",,,,,,,,")
-      throw Error(path + ":" + std::to_string(line_no) +
-                  ": expected id,x0,y0,z0,x1,y1,z1,observations,landmarks");
+    const auto bad = [&] {
+      return Error(path + ":" + std::to_string(line_no) +
+                   ": expected id,x0,y0,z0,x1,y1,z1,observations,landmarks[,midpoint_std_m]");
+    };
+    if (!is || std::string(c, 8) != ",,,,,,,,") throw bad();
+    // The tenth column is optional: files written before it was added have nine.
+    char sep = 0;
+    if (is >> sep && (sep != ',' || !(is >> l.midpoint_std_m))) throw bad();
     out.push_back(l);
   }
   return out;

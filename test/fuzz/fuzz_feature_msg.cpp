@@ -108,6 +108,7 @@ void fuzzMapKeyframe(FuzzedDataProvider& in) {
     l.end.x = in.ConsumeFloatingPoint<double>();
     l.observations = in.ConsumeIntegral<int32_t>();
     l.direction_std_deg = in.ConsumeFloatingPoint<double>();
+    l.midpoint_std_m = in.ConsumeFloatingPoint<double>();
   }
   const alvio::KeyframeLandmarks kf = alvio_ros::fromMsg(roundTrip(msg));
   check(kf.points.size() == msg.points.size());
@@ -116,7 +117,8 @@ void fuzzMapKeyframe(FuzzedDataProvider& in) {
     const auto& l = msg.lines[i];
     check(kf.lines[i].id == l.id && kf.lines[i].observations == l.observations &&
           same(kf.lines[i].p0_w.y(), l.start.y) &&
-          same(kf.lines[i].direction_std_deg, l.direction_std_deg));
+          same(kf.lines[i].direction_std_deg, l.direction_std_deg) &&
+          same(kf.lines[i].midpoint_std_m, l.midpoint_std_m));
   }
 }
 

@@ -71,6 +71,20 @@ TEST(LineMap, MergesCollinearOverlappingSegmentsOfDifferentIds) {
   EXPECT_EQ(map.lines().front().observations, 18);
 }
 
+TEST(LineMap, AMergedLineCarriesItsBestPlacedLandmarksUncertainty) {
+  LineMap map(keepAll());
+  map.addSegment(1, Vector3d(0, 0, 0), Vector3d(2, 0, 0), 10, kCamera);  // unknown
+  EXPECT_LT(map.lines().front().midpoint_std_m, 0);
+  map.addSegment(2, Vector3d(1, 0.01, 0), Vector3d(3, 0.01, 0), 6, kCamera, 0.02);
+  map.addSegment(3, Vector3d(2, 0.0, 0), Vector3d(4, 0.0, 0), 6, kCamera, 0.03);
+  ASSERT_EQ(map.size(), 1u);
+  EXPECT_DOUBLE_EQ(map.lines().front().midpoint_std_m, 0.02);
+  // Landmark 2 re-estimated less certainly: its latest estimate counts.
+  map.addSegment(2, Vector3d(1, 0.01, 0), Vector3d(3, 0.01, 0), 8, kCamera, 0.04);
+  ASSERT_EQ(map.size(), 1u);
+  EXPECT_DOUBLE_EQ(map.lines().front().midpoint_std_m, 0.03);
+}
+
 TEST(LineMap, DoesNotMergeParallelOffsetAngledOrDisjointSegments) {
   LineMap map(keepAll());
   map.addSegment(1, Vector3d(0, 0, 0), Vector3d(2, 0, 0), 10, kCamera);

@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "alvio/common/error.h"
+#include "alvio/io/trajectory_io.h"
 #include "alvio/mapping/map_builder.h"
 #include "alvio/mapping/map_files.h"
 #include "alvio/mapping/synthetic_room.h"
@@ -144,7 +145,8 @@ TEST(MapFiles, EveryFileReloadsWithItsOwnLibrary) {
   ASSERT_EQ(ply.element_order, (std::vector<std::string>{"vertex", "edge"}));
   EXPECT_EQ(ply.properties.at("vertex"), (std::vector<std::string>{"x", "y", "z"}));
   EXPECT_EQ(ply.properties.at("edge"),
-            (std::vector<std::string>{"vertex1", "vertex2", "id", "observations", "landmarks"}));
+            (std::vector<std::string>{"vertex1", "vertex2", "id", "observations", "landmarks",
+                                      "midpoint_std_m"}));
   ASSERT_EQ(ply.rows.at("vertex").size(), 2 * kept.size());
   ASSERT_EQ(ply.rows.at("edge").size(), kept.size());
   EXPECT_GE(ply.comments.size(), 4u);  // the columns are documented
@@ -156,6 +158,7 @@ TEST(MapFiles, EveryFileReloadsWithItsOwnLibrary) {
     EXPECT_NEAR(v1[2], kept[i].p1.z(), 1e-4);
     EXPECT_EQ(static_cast<int>(e[2]), kept[i].id);
     EXPECT_EQ(static_cast<int>(e[3]), kept[i].observations);
+    EXPECT_NEAR(e[5], kept[i].midpoint_std_m, 1e-6);
   }
 
   // CSV.
@@ -166,7 +169,32 @@ TEST(MapFiles, EveryFileReloadsWithItsOwnLibrary) {
     EXPECT_EQ(csv[i].observations, kept[i].observations);
     EXPECT_LT((csv[i].p0 - kept[i].p0).norm(), 1e-5);
     EXPECT_LT((csv[i].p1 - kept[i].p1).norm(), 1e-5);
+    EXPECT_NEAR(csv[i].midpoint_std_m, kept[i].midpoint_std_m, 1e-6);
   }
+}
+
+TEST(MapFiles, LinesCsvCarriesTheMidpointUncertaintyAndReadsOlderFiles) {
+  const std::string dir = test::scratchDir();
+  std::vector<MapLine> lines(2);
+  lines[0].id = 4;
+  lines[0].p1 = Eigen::Vector3d(1, 0, 0);
+  lines[0].midpoint_std_m = 0.0123;
+  lines[1].id = 9;
+  lines[1].p1 = Eigen::Vector3d(0, 2, 0);  // unknown: -1
+  writeFileAtomically(dir + "/lines.csv", linesToCsv(lines));
+  const std::vector<MapLine> back = readLinesCsv(dir + "/lines.csv");
+  ASSERT_EQ(back.size(), 2u);
+  EXPECT_NEAR(back[0].midpoint_std_m, 0.0123, 1e-9);
+  EXPECT_NEAR(back[1].midpoint_std_m, -1.0, 1e-9);
+  // Nine columns, as written before the uncertainty was added: read, uncertainty unknown.
+  std::ofstream(dir + "/old.csv") << "id,x0,y0,z0,x1,y1,z1,observations,landmarks\n"
+                                  << "3,0,0,0,1,0,0,7,2\n";
+  const std::vector<MapLine> old = readLinesCsv(dir + "/old.csv");
+  ASSERT_EQ(old.size(), 1u);
+  EXPECT_EQ(old[0].landmarks, 2);
+  EXPECT_LT(old[0].midpoint_std_m, 0);
+  std::ofstream(dir + "/junk.csv") << "3,0,0,0,1,0,0,7,2;0.5\n";
+  EXPECT_THROW(readLinesCsv(dir + "/junk.csv"), Error);
 }
 
 TEST(MapFiles, OctomapToolsReadTheBinaryTree) {

@@ -141,14 +141,14 @@ TEST(RosMessages, FeatureFrameSurvivesTheMessage) {
   EXPECT_DOUBLE_EQ(shared.features.stats.total_ms, 10.75);
 }
 
-TEST(RosMessages, MapKeyframeCarriesLineDirectionUncertainty) {
+TEST(RosMessages, MapKeyframeCarriesLineUncertainty) {
   alvio::KeyframeLandmarks kf;
   kf.t = 1600000002.5;
   kf.T_w_c = Eigen::Translation3d(1, 2, 3) * Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ());
   kf.points = {{1, {1, 1, 1}}, {2, {2, 2, 2}}};
-  kf.lines = {{5, {0, 0, 0}, {1, 0, 0}, 6, 0.5},
-              {6, {0, 0, 1}, {0, 1, 1}, 9, 3.0},
-              {7, {0, 0, 2}, {1, 1, 2}, 3, -1.0}};
+  kf.lines = {{5, {0, 0, 0}, {1, 0, 0}, 6, 0.5, 0.012},
+              {6, {0, 0, 1}, {0, 1, 1}, 9, 3.0, 0.25},
+              {7, {0, 0, 2}, {1, 1, 2}, 3, -1.0, -1.0}};
   std_msgs::Header header;
   header.stamp.fromSec(kf.t);
   alvio::MapKeyframe msg;
@@ -164,6 +164,7 @@ TEST(RosMessages, MapKeyframeCarriesLineDirectionUncertainty) {
     EXPECT_EQ(back.lines[i].observations, kf.lines[i].observations);
     EXPECT_EQ(back.lines[i].p1_w, kf.lines[i].p1_w);
     EXPECT_EQ(back.lines[i].direction_std_deg, kf.lines[i].direction_std_deg);
+    EXPECT_EQ(back.lines[i].midpoint_std_m, kf.lines[i].midpoint_std_m);
   }
 }
 

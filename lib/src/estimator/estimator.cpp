@@ -563,6 +563,7 @@ LineSegments3 Estimator::takeRetiredLines() {
     seg.start = toOutput(a).p;
     seg.end = toOutput(b).p;
     seg.direction_std_deg = l.direction_std_deg;
+    seg.midpoint_std_m = l.midpoint_std_m;
     seg.observations = l.track_observations;
     out.push_back(seg);
   }

@@ -54,6 +54,7 @@ struct LineSegment3 {
   Eigen::Vector3d end = Eigen::Vector3d::Zero();
   int observations = 0;           ///< in the window (0 for retired lines)
   double direction_std_deg = -1;  ///< 1-sigma direction uncertainty
+  double midpoint_std_m = -1;     ///< retired lines: 1-sigma midpoint uncertainty across the line
   EIGEN_MAKE_ALIGNED_OPERATOR_NEW
 };
 using LineSegments3 = std::vector<LineSegment3, Eigen::aligned_allocator<LineSegment3>>;

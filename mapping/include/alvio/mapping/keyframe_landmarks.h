@@ -32,6 +32,9 @@ struct LandmarkSegment {
   /// could not be computed. The map keeps only lines below MappingOptions'
   /// max_line_direction_std_deg (0, the default, always passes).
   double direction_std_deg = 0;
+  /// 1-sigma uncertainty of the midpoint across the line [m] (retired lines); negative:
+  /// unknown. Carried into the map files.
+  double midpoint_std_m = -1;
 };
 
 struct KeyframeLandmarks {

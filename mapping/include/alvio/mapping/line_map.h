@@ -65,6 +65,9 @@ struct MapLine {
   int observations = 0;    ///< image observations, summed over its landmarks
   int landmarks = 0;       ///< landmark IDs merged into it
   double min_depth_m = 0;  ///< closest distance to a camera that reported it
+  /// 1-sigma uncertainty of the midpoint across the line [m] of its best-placed landmark, as
+  /// the estimator computed it at retirement; negative when unknown.
+  double midpoint_std_m = -1;
   double length() const { return (p1 - p0).norm(); }
   Segment3 segment() const { return {p0, p1}; }
 };
@@ -74,10 +77,11 @@ class LineMap {
   explicit LineMap(const LineMapOptions& options = LineMapOptions());
 
   /// Add or update landmark `id` with the segment [p0_w, p1_w] supported by `observations`
-  /// image observations (cumulative for the ID), reported by a camera at `camera_w`.
-  /// Degenerate or non-finite segments are ignored (returns false).
+  /// image observations (cumulative for the ID), reported by a camera at `camera_w`, with
+  /// the landmark's midpoint uncertainty (negative: unknown). Degenerate or non-finite
+  /// segments are ignored (returns false).
   bool addSegment(int id, const Eigen::Vector3d& p0_w, const Eigen::Vector3d& p1_w,
-                  int observations, const Eigen::Vector3d& camera_w);
+                  int observations, const Eigen::Vector3d& camera_w, double midpoint_std_m = -1);
   /// Start a new keyframe (the clock of prune_weak_after_keyframes); prunes stale weak
   /// lines every few keyframes. Returns the number of lines deleted.
   std::size_t beginKeyframe();
@@ -108,6 +112,7 @@ class LineMap {
     int observations = 1;
     int landmarks = 1;
     double min_depth = 0;
+    double midpoint_std_m = -1;
     uint64_t stamp = 0;  ///< update counter, for folding the oldest
   };
   struct Line {
@@ -118,6 +123,7 @@ class LineMap {
     double t0 = 0, t1 = 0;  ///< extent along u from c
     int observations = 0, landmarks = 0;
     double min_depth = 0;
+    double midpoint_std_m = -1;  ///< the smallest known of its members'
     int64_t last_keyframe = 0;   ///< keyframe of the last update
     std::vector<int64_t> cells;  ///< grid cells it is registered in
     Eigen::Vector3d p0() const { return c + t0 * u; }
