@@ -45,7 +45,8 @@ int main(int argc, char** argv) {
   args.flag("no-texture-edges", "judge lines against the geometry's edges only (faster)");
   args.option("json", "write every figure to this JSON file");
   args.option("per-line",
-              "write each map line's error and endpoints (true world) to this CSV file");
+              "write each map line's error, endpoints (true world) and midpoint uncertainty "
+              "to this CSV file");
   try {
     if (!args.parse(argc, argv)) return 0;
     if (args.positional().size() != 2) throw Error("give RUN_DIR and SEQUENCE_DIR");
@@ -171,7 +172,7 @@ int main(int argc, char** argv) {
       std::ostringstream os;
       os << "id,length_m,observations,landmarks,edge,angle_deg,midpoint_distance_m,"
             "surface_distance_m,midpoint_surface_distance_m,precision,texture_midpoint_distance_m,"
-            "precision_with_texture_edges,x0,y0,z0,x1,y1,z1\n";
+            "precision_with_texture_edges,x0,y0,z0,x1,y1,z1,midpoint_std_m\n";
       for (const MapLine& l : map_lines) {
         const Segment3 s{traj.alignment.apply(l.p0), traj.alignment.apply(l.p1)};
         const LineError e = lineErrorToNearestEdge(s, edges);
@@ -186,7 +187,7 @@ int main(int argc, char** argv) {
            << "," << one.precision << "," << et.midpoint_distance_m << "," << one_t.precision;
         for (const Eigen::Vector3d& p : {s.p0, s.p1})
           os << "," << p.x() << "," << p.y() << "," << p.z();
-        os << "\n";
+        os << "," << l.midpoint_std_m << "\n";
       }
       writeFileAtomically(args.get("per-line"), os.str());
     }
