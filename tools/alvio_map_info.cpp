@@ -103,6 +103,8 @@ int main(int argc, char** argv) {
       }
       std::cout << "lines: " << lines.size() << ", total length " << length << " m, "
                 << observations << " observations\n";
+      const std::string uncertainty = describeLineUncertainty(lines);
+      if (!uncertainty.empty()) std::cout << uncertainty << "\n";
     } else {
       std::cout << "lines: (no " << kLinesCsvFileName << ")\n";
     }

@@ -3,7 +3,9 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <limits>
+#include <sstream>
 
 #include "alvio/common/error.h"
 #include "alvio/config/yaml_reader.h"
@@ -372,6 +374,28 @@ std::size_t LineMap::memoryBytes() const {
         sizeof(std::pair<const int64_t, std::vector<int>>) + kNode + keys.capacity() * sizeof(int);
   bytes += grid_.bucket_count() * sizeof(void*);
   return bytes;
+}
+
+std::string describeLineUncertainty(const std::vector<MapLine>& lines) {
+  std::vector<double> known;
+  double length = 0, length_under = 0;
+  int under = 0;
+  for (const MapLine& l : lines) {
+    length += l.length();
+    if (l.midpoint_std_m < 0) continue;
+    known.push_back(l.midpoint_std_m);
+    if (l.midpoint_std_m < 0.01) {
+      ++under;
+      length_under += l.length();
+    }
+  }
+  if (known.empty()) return "";
+  std::nth_element(known.begin(), known.begin() + known.size() / 2, known.end());
+  std::ostringstream os;
+  os << std::fixed << std::setprecision(1) << "midpoint uncertainty (1 sigma): median "
+     << 1000 * known[known.size() / 2] << " mm; " << under << " of " << lines.size() << " lines ("
+     << length_under << " m of " << length << ") under 1 cm";
+  return os.str();
 }
 
 }  // namespace alvio

@@ -85,6 +85,20 @@ TEST(LineMap, AMergedLineCarriesItsBestPlacedLandmarksUncertainty) {
   EXPECT_DOUBLE_EQ(map.lines().front().midpoint_std_m, 0.03);
 }
 
+TEST(LineMap, UncertaintySummaryCountsTheLinesUnderOneCentimetre) {
+  std::vector<MapLine> lines(4);
+  const double sigma[] = {0.004, 0.008, 0.02, -1};  // the last one unknown
+  for (int i = 0; i < 4; ++i) {
+    lines[i].p1 = Vector3d(i + 1.0, 0, 0);  // 1, 2, 3 and 4 m long
+    lines[i].midpoint_std_m = sigma[i];
+  }
+  EXPECT_EQ(describeLineUncertainty(lines),
+            "midpoint uncertainty (1 sigma): median 8.0 mm; 2 of 4 lines (3.0 m of 10.0) under "
+            "1 cm");
+  for (MapLine& l : lines) l.midpoint_std_m = -1;
+  EXPECT_EQ(describeLineUncertainty(lines), "");
+}
+
 TEST(LineMap, DoesNotMergeParallelOffsetAngledOrDisjointSegments) {
   LineMap map(keepAll());
   map.addSegment(1, Vector3d(0, 0, 0), Vector3d(2, 0, 0), 10, kCamera);

@@ -72,6 +72,10 @@ struct MapLine {
   Segment3 segment() const { return {p0, p1}; }
 };
 
+/// "midpoint uncertainty (1 sigma): median 6.9 mm; 58 of 108 lines (167.2 m of 226.2) under
+/// 1 cm", for map summaries; empty when no line's uncertainty is known.
+std::string describeLineUncertainty(const std::vector<MapLine>& lines);
+
 class LineMap {
  public:
   explicit LineMap(const LineMapOptions& options = LineMapOptions());

@@ -9,8 +9,11 @@
 //                           id               map line ID, as in lines.csv (int)
 //                           observations     image observations summed over merged landmarks
 //                           landmarks        landmark IDs merged into the line (int)
-//   lines.csv     header `id,x0,y0,z0,x1,y1,z1,observations,landmarks`, one line per row,
-//                 endpoints in the world frame (m)
+//                           midpoint_std_m   1-sigma midpoint uncertainty across the line of
+//                                            its best-placed landmark, m; -1 unknown (float)
+//   lines.csv     header `id,x0,y0,z0,x1,y1,z1,observations,landmarks,midpoint_std_m`, one
+//                 line per row, endpoints in the world frame (m); files without the last
+//                 column (written before it existed) still read
 //   map.3Dscene   an MRPT COpenGLScene (gzip-compressed, SceneViewer3D) with the objects
 //                 named "trajectory" (CSetOfLines, a strip through the body positions),
 //                 "points" (CPointCloud of point landmarks), "lines" (CSetOfLines, one
