@@ -412,9 +412,7 @@ void Estimator::updateLineUncertainty() {
       v.end_norm = obs.end_norm;
       views.push_back(v);
     }
-    const Eigen::Vector3d mid = l.has_extent ? Eigen::Vector3d(0.5 * (l.start_w + l.end_w))
-                                             : l.line_w.closestPointToOrigin();
-    l.direction_std_deg = lineUncertainty(l.line_w, mid, views, sigma).direction_std_deg;
+    l.direction_std_deg = lineDirectionStdDeg(l.line_w, views, sigma);
   }
 }
 

@@ -67,15 +67,13 @@ double lineCrossParallax(const Eigen::Vector3d& start_w, const Eigen::Vector3d& 
   return *median > 0 ? (hi - lo) / *median : 0;
 }
 
-LineUncertainty lineUncertainty(const PluckerLine& line_w, const Eigen::Vector3d& midpoint_w,
-                                const LineViews& views, double sigma) {
-  // Information of the four tangent parameters of the orthonormal representation, whitened by
-  // sigma; its inverse is their covariance.
-  double x[4];
-  OrthonormalLine::fromPlucker(line_w).toParameters(x);
-  const OrthonormalLineManifold manifold;
+namespace {
+// Covariance of the four tangent parameters of the orthonormal representation at x: the
+// inverse of the views' information, whitened by sigma. False when the views leave a
+// direction unconstrained.
+bool tangentCovariance(const double* x, const LineViews& views, double sigma, Eigen::Matrix4d* C) {
   Eigen::Matrix<double, 4, 4, Eigen::RowMajor> plus_jacobian;
-  manifold.PlusJacobian(x, plus_jacobian.data());
+  OrthonormalLineManifold().PlusJacobian(x, plus_jacobian.data());
   Eigen::Matrix4d H = Eigen::Matrix4d::Zero();
   for (const auto& v : views) {
     const LineProjectionFactor f(v.start_norm, v.end_norm, Eigen::Isometry3d::Identity(),
@@ -90,12 +88,34 @@ LineUncertainty lineUncertainty(const PluckerLine& line_w, const Eigen::Vector3d
     const Eigen::Matrix<double, 2, 4> Jt = J * plus_jacobian;
     H += Jt.transpose() * Jt;
   }
-  LineUncertainty u;
   const Eigen::FullPivLU<Eigen::Matrix4d> lu(H);
-  if (!lu.isInvertible()) return u;
-  const Eigen::Matrix4d C = lu.inverse();
-  // dtheta_x and dtheta_z turn the direction.
-  u.direction_std_deg = std::sqrt(std::max(0.0, C(0, 0) + C(2, 2))) * 180.0 / M_PI;
+  if (!lu.isInvertible()) return false;
+  *C = lu.inverse();
+  return true;
+}
+
+// dtheta_x and dtheta_z turn the direction.
+double directionStdDeg(const Eigen::Matrix4d& C) {
+  return std::sqrt(std::max(0.0, C(0, 0) + C(2, 2))) * 180.0 / M_PI;
+}
+}  // namespace
+
+double lineDirectionStdDeg(const PluckerLine& line_w, const LineViews& views, double sigma) {
+  double x[4];
+  OrthonormalLine::fromPlucker(line_w).toParameters(x);
+  Eigen::Matrix4d C;
+  return tangentCovariance(x, views, sigma, &C) ? directionStdDeg(C)
+                                                : LineUncertainty().direction_std_deg;
+}
+
+LineUncertainty lineUncertainty(const PluckerLine& line_w, const Eigen::Vector3d& midpoint_w,
+                                const LineViews& views, double sigma) {
+  double x[4];
+  OrthonormalLine::fromPlucker(line_w).toParameters(x);
+  LineUncertainty u;
+  Eigen::Matrix4d C;
+  if (!tangentCovariance(x, views, sigma, &C)) return u;
+  u.direction_std_deg = directionStdDeg(C);
   // How the line's point nearest the midpoint moves with each tangent step (central
   // differences; the step is small against any line a camera resolves).
   const auto nearest = [&](const double* xp) {
@@ -104,6 +124,7 @@ LineUncertainty lineUncertainty(const PluckerLine& line_w, const Eigen::Vector3d
     const Eigen::Vector3d p = l.closestPointToOrigin();
     return Eigen::Vector3d(p + d * d.dot(midpoint_w - p));
   };
+  const OrthonormalLineManifold manifold;
   Eigen::Matrix<double, 3, 4> Jm;
   const double h = 1e-6;
   for (int k = 0; k < 4; ++k) {

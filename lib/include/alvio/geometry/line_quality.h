@@ -41,5 +41,7 @@ struct LineUncertainty {
 };
 LineUncertainty lineUncertainty(const PluckerLine& line_w, const Eigen::Vector3d& midpoint_w,
                                 const LineViews& views, double sigma);
+/// Only the direction's part (for the window's lines, every frame).
+double lineDirectionStdDeg(const PluckerLine& line_w, const LineViews& views, double sigma);
 
 }  // namespace alvio
