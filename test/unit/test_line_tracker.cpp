@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <iostream>
 #include <map>
 #include <opencv2/imgcodecs.hpp>
 #include <set>
@@ -15,6 +16,7 @@
 #include "alvio/config/yaml_reader.h"
 #include "alvio/lines/descriptor_line_tracker.h"
 #include "alvio/lines/line_detector.h"
+#include "alvio/lines/linear_time_lsd.h"
 #include "alvio/lines/optical_flow_line_tracker.h"
 #include "synthetic_line_scene.h"
 #include "test_support.h"
@@ -146,6 +148,71 @@ TEST(LineDetector, LsdOnAScaledImageFindsStepEdgesWhereTheyAre) {
     EXPECT_NEAR(sum_x / n_x, 0.0, 0.05) << "mean x offset at scale " << scale;
     EXPECT_NEAR(sum_y / n_y, 0.0, 0.05) << "mean y offset at scale " << scale;
   }
+}
+
+namespace {
+// Does `b` have a segment with both endpoints within 1 px of `s`'s (either way round)?
+bool hasCounterpart(const cv::Vec4f& s, const std::vector<cv::Vec4f>& b) {
+  return std::any_of(b.begin(), b.end(), [&](const cv::Vec4f& t) {
+    return std::hypot(s[0] - t[0], s[1] - t[1]) < 1 && std::hypot(s[2] - t[2], s[3] - t[3]) < 1;
+  });
+}
+double lengthOf(const cv::Vec4f& s) {
+  return std::hypot(s[2] - s[0], s[3] - s[1]);
+}
+}  // namespace
+
+TEST(LinearTimeLsd, FindsOpenCvsSegmentsOnRealEuRoCFrames) {
+  // The same algorithm and constants as OpenCV's LSD without refinement; only seeds of one
+  // gradient bin may be tried in another order, so nearly every segment must be the same.
+  const std::string dir = test::sharedDataDir();
+  if (dir.empty()) GTEST_SKIP() << "../shared/data not found: no real EuRoC frames to compare on";
+  const std::filesystem::path images = dir + "/euroc_V1_01_easy_micro_kimera/mav0/cam0/data";
+  if (!std::filesystem::is_directory(images)) GTEST_SKIP() << images << " not found";
+  std::vector<std::filesystem::path> files;
+  for (const auto& e : std::filesystem::directory_iterator(images)) files.push_back(e.path());
+  std::sort(files.begin(), files.end());
+  ASSERT_GE(files.size(), 10u);
+  const LineDetectorOptions o;  // the defaults: scale 0.5, sigma 0.6, quant 2
+  const auto opencv = cv::createLineSegmentDetector(cv::LSD_REFINE_NONE, o.lsd_scale,
+                                                    o.lsd_sigma_scale, o.lsd_quant);
+  LinearTimeLsd linear(o.lsd_scale, o.lsd_sigma_scale, o.lsd_quant);
+  const double shortest = LineDetector(o, kSize).shortestLength();
+  int theirs = 0, theirs_found = 0, ours = 0, ours_found = 0;
+  for (std::size_t i = 0; i < files.size(); i += files.size() / 10) {
+    const cv::Mat image = cv::imread(files[i].string(), cv::IMREAD_GRAYSCALE);
+    ASSERT_FALSE(image.empty()) << files[i];
+    std::vector<cv::Vec4f> a, b;
+    opencv->detect(image, a);
+    linear.detect(image, &b);
+    for (const cv::Vec4f& s : a)
+      if (lengthOf(s) >= shortest) theirs_found += hasCounterpart(s, b), ++theirs;
+    for (const cv::Vec4f& s : b)
+      if (lengthOf(s) >= shortest) ours_found += hasCounterpart(s, a), ++ours;
+  }
+  std::cout << theirs_found << " of OpenCV's " << theirs << " segments found, " << ours_found
+            << " of ours " << ours << " found by OpenCV\n";
+  ASSERT_GT(theirs, 500);
+  EXPECT_GE(theirs_found, 0.98 * theirs);
+  EXPECT_GE(ours_found, 0.98 * ours);
+}
+
+TEST(LinearTimeLsd, AnImageWithoutEdgesHasNoSegments) {
+  LinearTimeLsd lsd(0.5, 0.6, 2.0);
+  std::vector<cv::Vec4f> out{{1, 2, 3, 4}};
+  lsd.detect(cv::Mat(kSize, CV_8UC1, cv::Scalar(90)), &out);
+  EXPECT_TRUE(out.empty());
+  lsd.detect(cv::Mat(1, 1, CV_8UC1, cv::Scalar(90)), &out);
+  EXPECT_TRUE(out.empty());
+}
+
+TEST(LineDetector, RefinementNeedsOpenCvsLsd) {
+  LineDetectorOptions o;
+  o.lsd_refine = true;
+  EXPECT_NE(test::errorOf([&] { o.validate("lines.detector"); }).find("lsd_refine"),
+            std::string::npos);
+  o.method = "opencv_lsd";
+  EXPECT_NO_THROW(o.validate("lines.detector"));
 }
 
 TEST(LineDetector, FldOnAScaledImageReturnsFullResolutionSegments) {

@@ -83,6 +83,9 @@ void detectLines(benchmark::State& state, const std::string& method, double fld_
 void BM_LineDetectionLsd(benchmark::State& state) {
   detectLines(state, "lsd");
 }
+void BM_LineDetectionOpenCvLsd(benchmark::State& state) {
+  detectLines(state, "opencv_lsd");
+}
 void BM_LineDetectionLsdRefined(benchmark::State& state) {
   detectLines(state, "lsd", 1.0, true);
 }
@@ -93,6 +96,7 @@ void BM_LineDetectionFldHalfScale(benchmark::State& state) {
   detectLines(state, "fld", 0.5);
 }
 BENCHMARK(BM_LineDetectionLsd)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_LineDetectionOpenCvLsd)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_LineDetectionLsdRefined)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_LineDetectionFld)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_LineDetectionFldHalfScale)->Unit(benchmark::kMillisecond);

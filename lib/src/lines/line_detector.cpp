@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "alvio/lines/edge_refinement.h"
+#include "alvio/lines/linear_time_lsd.h"
 
 namespace alvio {
 
@@ -11,17 +12,20 @@ LineDetector::LineDetector(const LineDetectorOptions& options, cv::Size image_si
     : options_(options) {
   options_.validate("line detector");
   min_length_ = options_.min_length_ratio * std::hypot(image_size.width, image_size.height);
-  // OpenCV's defaults apart from the scale, sigma, quant and refinement (angle 22.5 deg,
-  // log_eps 0, density 0.7, 1024 bins).
+  // OpenCV's LSD: its defaults apart from the scale, sigma, quant and refinement (angle
+  // 22.5 deg, log_eps 0, density 0.7, 1024 bins); LinearTimeLsd has the same constants.
   if (options_.method == "fld")
     // Segments shorter than any we keep are not worth FLD's fitting; no merging (the tracker
     // merges split lines itself, as Type 3).
     fld_ = cv::ximgproc::createFastLineDetector(
         static_cast<int>(shortestLength() * options_.fld_scale), 1.41421356f, 50.0, 50.0, 3, false);
-  else
-    lsd_ = cv::createLineSegmentDetector(
+  else if (options_.method == "opencv_lsd")
+    opencv_lsd_ = cv::createLineSegmentDetector(
         options_.lsd_refine ? cv::LSD_REFINE_STD : cv::LSD_REFINE_NONE, options_.lsd_scale,
         options_.lsd_sigma_scale, options_.lsd_quant);
+  else
+    lsd_ = std::make_unique<LinearTimeLsd>(options_.lsd_scale, options_.lsd_sigma_scale,
+                                           options_.lsd_quant);
 }
 
 namespace {
@@ -46,9 +50,12 @@ std::vector<LineSegment> LineDetector::detect(const cv::Mat& gray, const cv::Mat
   } else if (fld_) {
     fld_->detect(gray, raw);
   } else {
-    // OpenCV's LSD returns u_s / s for a scaled run: without the shift every segment sat
-    // 0.5 px up and left of its edge at lsd_scale 0.5 (test_line_tracker).
-    lsd_->detect(gray, raw);
+    // Both LSDs return u_s / s for a scaled run: without the shift every segment sat 0.5 px up
+    // and left of its edge at lsd_scale 0.5 (test_line_tracker).
+    if (lsd_)
+      lsd_->detect(gray, &raw);
+    else
+      opencv_lsd_->detect(gray, raw);
     if (options_.lsd_scale < 1) shift(&raw, scaleShift(options_.lsd_scale));
   }
 

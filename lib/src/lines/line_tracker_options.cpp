@@ -46,8 +46,10 @@ LineDetectorOptions LineDetectorOptions::load(const YamlReader& yaml, const std:
 }
 
 void LineDetectorOptions::validate(const std::string& where) const {
-  if (method != "lsd" && method != "fld")
-    throw Error(where + ": key 'method' must be lsd or fld, got '" + method + "'");
+  if (method != "lsd" && method != "opencv_lsd" && method != "fld")
+    throw Error(where + ": key 'method' must be lsd, opencv_lsd or fld, got '" + method + "'");
+  if (lsd_refine && method != "opencv_lsd")
+    throw Error(where + ": key 'lsd_refine' needs method opencv_lsd (got method '" + method + "')");
   require(min_length_ratio > 0 && min_length_ratio < 1, where, "min_length_ratio", "in (0, 1)",
           min_length_ratio);
   require(continuation_length_factor > 0 && continuation_length_factor <= 1, where,

@@ -1,8 +1,9 @@
 #pragma once
-// Line segment detection, LSD (OpenCV's cv::LineSegmentDetector) or FLD (ximgproc), with a minimum
-// length and a cap on the count (the longest are kept). The detector is built once and reused for
-// every frame.
+// Line segment detection, LSD (linear_time_lsd.h, or OpenCV's cv::LineSegmentDetector) or FLD
+// (ximgproc), with a minimum length and a cap on the count (the longest are kept). The detector is
+// built once and reused for every frame.
 
+#include <memory>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/ximgproc/fast_line_detector.hpp>
@@ -10,6 +11,7 @@
 
 #include "alvio/lines/line_segment.h"
 #include "alvio/lines/line_tracker_options.h"
+#include "alvio/lines/linear_time_lsd.h"
 
 namespace alvio {
 
@@ -31,7 +33,8 @@ class LineDetector {
  private:
   LineDetectorOptions options_;
   double min_length_;
-  cv::Ptr<cv::LineSegmentDetector> lsd_;
+  std::unique_ptr<LinearTimeLsd> lsd_;
+  cv::Ptr<cv::LineSegmentDetector> opencv_lsd_;
   cv::Ptr<cv::ximgproc::FastLineDetector> fld_;
   cv::Mat scaled_;       // FLD's resized input, reused
   cv::Mat source_mask_;  // the valid mask last seen (compared by data pointer)

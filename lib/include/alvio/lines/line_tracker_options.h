@@ -16,8 +16,9 @@ namespace alvio {
 class YamlReader;
 
 struct LineDetectorOptions {
-  /// "lsd" (OpenCV's LSD, as in the paper) or "fld" (ximgproc's FastLineDetector: Canny edges
-  /// fitted by lines, several times faster than LSD on EuRoC-size images).
+  /// "lsd" (LSD as in the paper, with linear-time seed ordering: linear_time_lsd.h),
+  /// "opencv_lsd" (OpenCV's cv::LineSegmentDetector, needed for lsd_refine) or "fld" (ximgproc's
+  /// FastLineDetector: Canny edges fitted by lines).
   std::string method = "lsd";
   /// Minimum length of a new line as a fraction of the image diagonal (0.06 * 892 px = 54 px).
   double min_length_ratio = 0.06;
@@ -37,7 +38,7 @@ struct LineDetectorOptions {
   /// FLD works on the image resized by this factor (area averaging). 0.5 is 3.5x faster than
   /// LSD at its 0.5, but its flow tracks are a third shorter (docs/benchmarks.md).
   double fld_scale = 1.0;
-  /// LSD_REFINE_STD (true: splits segments at bends) or LSD_REFINE_NONE.
+  /// LSD_REFINE_STD (true: splits segments at bends; method opencv_lsd only) or LSD_REFINE_NONE.
   bool lsd_refine = false;
   /// LSD's bound on the gradient's quantisation error (OpenCV's `quant`): pixels whose
   /// gradient is under quant / sin(22.5 deg) grow no region. Larger skips faint edges.

@@ -1,0 +1,56 @@
+#pragma once
+// LSD, the Line Segment Detector of von Gioi et al. (IPOL 2012), without refinement: the steps
+// and constants of OpenCV's cv::LineSegmentDetector with LSD_REFINE_NONE (Gaussian blur and
+// scaling, 2x2 gradient, region growing at 22.5 deg, rectangle by the region's inertia), but
+// seeds ordered as the paper orders them.
+//
+// OpenCV 4.6 puts every pixel of the scaled image into one list and std::sorts it by gradient
+// (about 90 000 entries on a EuRoC frame at scale 0.5), which is most of its time. Here only
+// the pixels that can start a region (gradient above the threshold, a fifth of them) are
+// ordered, by a counting sort over the same 1024 bins, in raster order within a bin. Seeds in
+// one bin may therefore be tried in another order than OpenCV's, so a few segments differ;
+// test_line_detector compares the two.
+
+#include <opencv2/core.hpp>
+#include <vector>
+
+namespace alvio {
+
+class LinearTimeLsd {
+ public:
+  /// `scale` and `sigma_scale` as OpenCV's (sigma = sigma_scale / scale when scale < 1);
+  /// `quant` bounds the gradient's quantisation error (threshold quant / sin(22.5 deg)).
+  LinearTimeLsd(double scale, double sigma_scale, double quant);
+
+  /// Segments (x1, y1, x2, y2) in the input image's pixels, in OpenCV's convention: a scaled
+  /// image coordinate u_s comes back as (u_s + 0.5) / scale. `gray` is CV_8UC1.
+  void detect(const cv::Mat& gray, std::vector<cv::Vec4f>* segments);
+
+ private:
+  struct RegionPixel {
+    int x, y;
+    float angle, gradient;
+  };
+
+  void computeGradient();
+  void orderSeeds();
+  /// Grows the region of pixels aligned with the seed's running mean direction (8-connected).
+  /// Returns that mean direction [rad].
+  double growRegion(int seed);
+  /// The region's rectangle: its gradient-weighted centre, its axis of least inertia, and the
+  /// extreme projections on that axis, as a segment in scaled-image pixels.
+  cv::Vec4d regionToSegment(double region_angle) const;
+  bool aligned(int index, double angle) const;
+
+  double scale_, sigma_scale_, threshold_;
+  cv::Mat blurred_, scaled_;
+  int width_ = 0, height_ = 0;
+  std::vector<float> angle_;     // gradient direction [rad], or kUndefined
+  std::vector<float> gradient_;  // gradient norm
+  std::vector<uint8_t> used_;
+  std::vector<int> seeds_;  // pixel indices, strongest gradient bin first
+  std::vector<int> bin_count_;
+  std::vector<RegionPixel> region_;
+};
+
+}  // namespace alvio
