@@ -11,6 +11,7 @@
 #include <alvio/ZeroCopyReport.h>
 
 #include <cstring>
+#include <iterator>
 #include <map>
 
 #include "conversions.h"
@@ -34,33 +35,55 @@ class ZeroCopyMonitorNodelet : public GuardedNodelet {
 
   void onImage(const sensor_msgs::ImageConstPtr& image) {
     ++report_.camera_images;
-    // Held until matched, so that a freed image's address cannot be reused by a copy.
-    recent_[toNs(image->header.stamp)] = image;
-    while (recent_.size() > 30) recent_.erase(recent_.begin());
+    const int64_t stamp = toNs(image->header.stamp);
+    // Across processes a frame can arrive before the image it was made from.
+    const auto waiting = pending_.find(stamp);
+    if (waiting != pending_.end()) {
+      classify(*image, *waiting->second->image);
+      // Images arrive in order: a frame older than this image will never find its own.
+      report_.unmatched += static_cast<uint32_t>(std::distance(pending_.begin(), waiting));
+      pending_.erase(pending_.begin(), std::next(waiting));
+      report_pub_.publish(boost::make_shared<alvio::ZeroCopyReport>(report_));
+      return;
+    }
+    // Held until matched, so that a freed image's address cannot be reused by a copy. 100
+    // images let the tracker fall 5 s behind on a loaded machine.
+    recent_[stamp] = image;
+    while (recent_.size() > 100) recent_.erase(recent_.begin());
   }
 
   void onFrame(const SharedTrackedFrame::ConstPtr& frame) {
     ++report_.frames;
-    const auto it = recent_.find(toNs(frame->features.header.stamp));
-    if (it == recent_.end() || !frame->image) {
+    const int64_t stamp = toNs(frame->features.header.stamp);
+    const auto it = recent_.find(stamp);
+    if (!frame->image) {
       ++report_.unmatched;
-    } else {
-      const sensor_msgs::Image& a = *it->second;
-      const sensor_msgs::Image& b = *frame->image;
-      if (&a == &b && a.data.data() == b.data.data())
-        ++report_.shared;
-      else if (a.data.size() == b.data.size() &&
-               std::memcmp(a.data.data(), b.data.data(), a.data.size()) == 0)
-        ++report_.copied;
-      else
-        ++report_.unmatched;
+    } else if (it != recent_.end()) {
+      classify(*it->second, *frame->image);
       recent_.erase(recent_.begin(), std::next(it));
+    } else {
+      pending_[stamp] = frame;
+      while (pending_.size() > 30) {
+        pending_.erase(pending_.begin());
+        ++report_.unmatched;
+      }
     }
     report_pub_.publish(boost::make_shared<alvio::ZeroCopyReport>(report_));
   }
 
+  void classify(const sensor_msgs::Image& camera, const sensor_msgs::Image& in_frame) {
+    if (&camera == &in_frame && camera.data.data() == in_frame.data.data())
+      ++report_.shared;
+    else if (camera.data.size() == in_frame.data.size() &&
+             std::memcmp(camera.data.data(), in_frame.data.data(), camera.data.size()) == 0)
+      ++report_.copied;
+    else
+      ++report_.unmatched;
+  }
+
   alvio::ZeroCopyReport report_;
   std::map<int64_t, sensor_msgs::ImageConstPtr> recent_;
+  std::map<int64_t, SharedTrackedFrame::ConstPtr> pending_;  // frames whose image is not here yet
   ros::Publisher report_pub_;
   ros::Subscriber image_sub_, frame_sub_;
 };
