@@ -44,6 +44,19 @@ OccupancyMap::OccupancyMap(const OccupancyMapOptions& options)
 
 namespace {
 constexpr double kMaxRayLength_m = 100.0;
+
+// The leaf at full depth for `key`, or nullptr where it does not exist yet or lies inside a
+// pruned node (there OcTree::updateNode has to create or expand nodes).
+octomap::OcTreeNode* fullDepthLeaf(const octomap::OcTree& tree, const octomap::OcTreeKey& key) {
+  octomap::OcTreeNode* node = tree.getRoot();
+  if (!node) return nullptr;
+  for (int level = static_cast<int>(tree.getTreeDepth()) - 1; level >= 0; --level) {
+    const unsigned int child = octomap::computeChildIdx(key, level);
+    if (!tree.nodeChildExists(node, child)) return nullptr;
+    node = tree.getNodeChild(node, child);
+  }
+  return node;
+}
 }  // namespace
 
 void OccupancyMap::syncInnerNodes() const {
@@ -78,9 +91,22 @@ void OccupancyMap::insert(const Eigen::Vector3d& origin_w,
   for (const Eigen::Vector3d& p : points_w)
     if (p.allFinite() && (p - origin_w).norm() < kMaxRayLength_m)
       cloud.push_back(p.x(), p.y(), p.z());
-  // discretize: one ray per end voxel, which matters for densely sampled lines.
-  tree_->insertPointCloud(cloud, origin, options_.max_range, /*lazy_eval=*/true,
-                          /*discretize=*/true);
+  // As OcTree::insertPointCloud with lazy evaluation and discretisation (one ray per end voxel,
+  // which matters for densely sampled lines), but an existing leaf is updated where it is
+  // found: updateNode searches for it and then descends to it a second time. Same map, same
+  // order of updates.
+  octomap::KeySet free_cells, occupied_cells;
+  tree_->computeDiscreteUpdate(cloud, origin, free_cells, occupied_cells, options_.max_range);
+  const bool in_place = !tree_->isChangeDetectionEnabled();
+  auto update = [&](const octomap::OcTreeKey& key, bool occupied) {
+    octomap::OcTreeNode* leaf = in_place ? fullDepthLeaf(*tree_, key) : nullptr;
+    if (leaf)
+      tree_->updateNodeLogOdds(leaf, occupied ? tree_->getProbHitLog() : tree_->getProbMissLog());
+    else
+      tree_->updateNode(key, occupied, /*lazy_eval=*/true);
+  };
+  for (const octomap::OcTreeKey& key : free_cells) update(key, false);
+  for (const octomap::OcTreeKey& key : occupied_cells) update(key, true);
   inner_nodes_stale_ = true;
 }
 

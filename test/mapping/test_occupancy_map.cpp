@@ -133,3 +133,43 @@ TEST(OccupancyMap, LazyInsertionBuildsTheEagerTree) {
   EXPECT_EQ(map.tree().size(), eager.size());
   EXPECT_GT(map.counts().occupied, 100u);
 }
+
+TEST(OccupancyMap, InPlaceUpdatesGiveOctomapsOwnLogOdds) {
+  // Against octomap's own insertPointCloud, log-odds and all (the full .ot format), with the
+  // tree pruned halfway so that later rays also meet pruned nodes.
+  OccupancyMap map;
+  octomap::OcTree reference(map.options().resolution);
+  reference.setProbHit(map.options().hit);
+  reference.setProbMiss(map.options().miss);
+  reference.setClampingThresMin(map.options().clamp_min);
+  reference.setClampingThresMax(map.options().clamp_max);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int k = 0; k < 40; ++k) {
+    const Vector3d origin(0.05 * k, 0.3 * u(rng), 0.2 * u(rng));
+    std::vector<Vector3d> points;
+    octomap::Pointcloud cloud;
+    for (int i = 0; i < 150; ++i) {
+      // Enough repeats of the same wall and floor to clamp many voxels.
+      const Vector3d p = i % 2 ? Vector3d(3.0, 2 * u(rng), 0.5 * u(rng))
+                               : Vector3d(1.5 + u(rng), 1.5 * u(rng), -1.0);
+      points.push_back(p);
+      cloud.push_back(p.x(), p.y(), p.z());
+    }
+    map.insert(origin, points);
+    reference.insertPointCloud(cloud, octomap::point3d(origin.x(), origin.y(), origin.z()),
+                               map.options().max_range, /*lazy_eval=*/true, /*discretize=*/true);
+    if (k == 20) {
+      ASSERT_GT(map.tree().size(), 0u);  // reading the tree updates and prunes it
+      reference.updateInnerOccupancy();
+      reference.prune();
+    }
+  }
+  reference.updateInnerOccupancy();
+  reference.prune();
+  std::ostringstream ours, theirs;
+  map.tree().write(ours);
+  reference.write(theirs);
+  EXPECT_EQ(ours.str(), theirs.str());
+  EXPECT_GT(map.counts().occupied, 50u);
+}
