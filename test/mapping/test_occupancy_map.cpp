@@ -19,6 +19,14 @@ KeyframeLandmarks keyframeAtOrigin() {
   kf.T_w_c = Eigen::Isometry3d::Identity();
   return kf;
 }
+
+// Gives a plain octomap tree, to compare against, the map's sensor model.
+void setSensorModelOf(const OccupancyMap& map, octomap::OcTree* tree) {
+  tree->setProbHit(map.options().hit);
+  tree->setProbMiss(map.options().miss);
+  tree->setClampingThresMin(map.options().clamp_min);
+  tree->setClampingThresMax(map.options().clamp_max);
+}
 }  // namespace
 
 TEST(OccupancyMap, SampledSegmentIsOccupiedAndRaysAreFree) {
@@ -105,10 +113,7 @@ TEST(OccupancyMap, OptionsUseOctomapServerNames) {
 TEST(OccupancyMap, LazyInsertionBuildsTheEagerTree) {
   OccupancyMap map;
   octomap::OcTree eager(map.options().resolution);
-  eager.setProbHit(map.options().hit);
-  eager.setProbMiss(map.options().miss);
-  eager.setClampingThresMin(map.options().clamp_min);
-  eager.setClampingThresMax(map.options().clamp_max);
+  setSensorModelOf(map, &eager);
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   for (int k = 0; k < 30; ++k) {
@@ -139,10 +144,7 @@ TEST(OccupancyMap, InPlaceUpdatesGiveOctomapsOwnLogOdds) {
   // tree pruned halfway so that later rays also meet pruned nodes.
   OccupancyMap map;
   octomap::OcTree reference(map.options().resolution);
-  reference.setProbHit(map.options().hit);
-  reference.setProbMiss(map.options().miss);
-  reference.setClampingThresMin(map.options().clamp_min);
-  reference.setClampingThresMax(map.options().clamp_max);
+  setSensorModelOf(map, &reference);
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   for (int k = 0; k < 40; ++k) {
