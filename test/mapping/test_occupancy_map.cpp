@@ -27,6 +27,16 @@ void setSensorModelOf(const OccupancyMap& map, octomap::OcTree* tree) {
   tree->setClampingThresMin(map.options().clamp_min);
   tree->setClampingThresMax(map.options().clamp_max);
 }
+
+// The same points into the map and, through octomap's own discretised insertion, the tree.
+void insertIntoBoth(const Vector3d& origin, const std::vector<Vector3d>& points, OccupancyMap* map,
+                    octomap::OcTree* tree, bool tree_lazy_eval) {
+  octomap::Pointcloud cloud;
+  for (const Vector3d& p : points) cloud.push_back(p.x(), p.y(), p.z());
+  map->insert(origin, points);
+  tree->insertPointCloud(cloud, octomap::point3d(origin.x(), origin.y(), origin.z()),
+                         map->options().max_range, tree_lazy_eval, /*discretize=*/true);
+}
 }  // namespace
 
 TEST(OccupancyMap, SampledSegmentIsOccupiedAndRaysAreFree) {
@@ -119,17 +129,11 @@ TEST(OccupancyMap, LazyInsertionBuildsTheEagerTree) {
   for (int k = 0; k < 30; ++k) {
     const Vector3d origin(0.1 * k, 0.3 * u(rng), 0.2 * u(rng));
     std::vector<Vector3d> points;
-    octomap::Pointcloud cloud;
-    for (int i = 0; i < 200; ++i) {
+    for (int i = 0; i < 200; ++i)
       // A wall at x = 4 and a floor at z = -1, seen again and again from moving cameras.
-      const Vector3d p = i % 2 ? Vector3d(4.0, 3 * u(rng), u(rng))
-                               : Vector3d(0.1 * k + 2 * u(rng), 2 * u(rng), -1.0);
-      points.push_back(p);
-      cloud.push_back(p.x(), p.y(), p.z());
-    }
-    map.insert(origin, points);
-    eager.insertPointCloud(cloud, octomap::point3d(origin.x(), origin.y(), origin.z()),
-                           map.options().max_range, false, true);
+      points.push_back(i % 2 ? Vector3d(4.0, 3 * u(rng), u(rng))
+                             : Vector3d(0.1 * k + 2 * u(rng), 2 * u(rng), -1.0));
+    insertIntoBoth(origin, points, &map, &eager, /*tree_lazy_eval=*/false);
   }
   std::ostringstream lazy_bytes, eager_bytes;
   map.tree().writeBinaryConst(lazy_bytes);
@@ -150,17 +154,11 @@ TEST(OccupancyMap, InPlaceUpdatesGiveOctomapsOwnLogOdds) {
   for (int k = 0; k < 40; ++k) {
     const Vector3d origin(0.05 * k, 0.3 * u(rng), 0.2 * u(rng));
     std::vector<Vector3d> points;
-    octomap::Pointcloud cloud;
-    for (int i = 0; i < 150; ++i) {
+    for (int i = 0; i < 150; ++i)
       // Enough repeats of the same wall and floor to clamp many voxels.
-      const Vector3d p = i % 2 ? Vector3d(3.0, 2 * u(rng), 0.5 * u(rng))
-                               : Vector3d(1.5 + u(rng), 1.5 * u(rng), -1.0);
-      points.push_back(p);
-      cloud.push_back(p.x(), p.y(), p.z());
-    }
-    map.insert(origin, points);
-    reference.insertPointCloud(cloud, octomap::point3d(origin.x(), origin.y(), origin.z()),
-                               map.options().max_range, /*lazy_eval=*/true, /*discretize=*/true);
+      points.push_back(i % 2 ? Vector3d(3.0, 2 * u(rng), 0.5 * u(rng))
+                             : Vector3d(1.5 + u(rng), 1.5 * u(rng), -1.0));
+    insertIntoBoth(origin, points, &map, &reference, /*tree_lazy_eval=*/true);
     if (k == 20) {
       ASSERT_GT(map.tree().size(), 0u);  // reading the tree updates and prunes it
       reference.updateInnerOccupancy();
