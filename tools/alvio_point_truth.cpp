@@ -59,8 +59,8 @@ int main(int argc, char** argv) {
   ArgParser args("alvio_point_truth",
                  "Point tracks against the simulator's true scene; --oracle runs the estimator\n"
                  "on the true projections of the same tracks.\n"
-                 "Usage: alvio_point_truth --config FILE [options] SEQUENCE_DIR");
-  args.option("config", "configuration", "");
+                 "Usage: alvio_point_truth [--config FILE] [options] SEQUENCE_DIR");
+  args.option("config", "configuration (default: the installed config/euroc.yaml)", "");
   args.option("out", "folder for trajectory.tum and point_errors.csv", "");
   args.option("frames", "frames to use (0: all)", "0");
   args.option("oracle-noise-px", "with --oracle: Gaussian noise added to the true positions", "0");
@@ -72,7 +72,7 @@ int main(int argc, char** argv) {
     const std::vector<std::string>& positional = args.positional();
     if (positional.size() != 1) throw Error("one SEQUENCE_DIR is required");
     const std::string seq = positional[0];
-    Config config = Config::load(args.get("config"));
+    Config config = Config::load(args.isSet("config") ? args.get("config") : Config::defaultPath());
     if (args.isSet("no-lines")) config.estimator.use_lines = false;
     const bool oracle = args.isSet("oracle");
     const double oracle_noise = std::stod(args.get("oracle-noise-px"));
@@ -197,6 +197,9 @@ int main(int argc, char** argv) {
       if (frame_index % 200 == 0)
         std::cerr << "frame " << frame_index << " / " << data.images().size() << "\n";
     }
+    if (estimate.empty())
+      throw Error("the estimator gave no pose in " + std::to_string(frame_index) +
+                  " frames (not initialised): nothing to evaluate");
     const EvaluationResult e = evaluateTrajectory(estimate, gt, EvaluationOptions());
     std::cout << std::fixed << std::setprecision(4) << "frames " << frame_index << " poses "
               << estimate.size() << " resets " << estimator.resetCount() << " ATE "
