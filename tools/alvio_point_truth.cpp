@@ -61,7 +61,7 @@ int main(int argc, char** argv) {
                  "on the true projections of the same tracks.\n"
                  "Usage: alvio_point_truth [--config FILE] [options] SEQUENCE_DIR");
   args.option("config", "configuration (default: the installed config/euroc.yaml)", "");
-  args.option("out", "folder for trajectory.tum and point_errors.csv", "");
+  args.option("out", "folder for trajectory.tum, point_errors.csv, point_observations.csv", "");
   args.option("frames", "frames to use (0: all)", "0");
   args.option("oracle-noise-px", "with --oracle: Gaussian noise added to the true positions", "0");
   args.option("drop-px", "drop tracked observations this far from the truth (0: keep all)", "0");
@@ -75,9 +75,9 @@ int main(int argc, char** argv) {
     Config config = Config::load(args.isSet("config") ? args.get("config") : Config::defaultPath());
     if (args.isSet("no-lines")) config.estimator.use_lines = false;
     const bool oracle = args.isSet("oracle");
-    const double oracle_noise = std::stod(args.get("oracle-noise-px"));
-    const double drop_px = std::stod(args.get("drop-px"));
-    const int max_frames = std::stoi(args.get("frames"));
+    const double oracle_noise = args.getDouble("oracle-noise-px");
+    const double drop_px = args.getDouble("drop-px");
+    const int max_frames = args.getInt("frames");
     const std::string out_dir = args.get("out");
     if (!out_dir.empty()) fs::create_directories(out_dir);
 
@@ -186,7 +186,11 @@ int main(int argc, char** argv) {
                      << sum_err.x() / n << ',' << sum_err.y() / n << ',' << median(flows) << '\n';
         }
       }
-      if (estimator.addFrame(frame)) {
+      const int resets_before = estimator.resetCount();
+      const bool has_pose = estimator.addFrame(frame);
+      // As VioPipeline: after a reset the tracks start again.
+      if (estimator.resetCount() != resets_before) front_end.resetPoints();
+      if (has_pose) {
         const BodyState st = estimator.latestState();
         StampedPose p;
         p.t = st.t;
