@@ -47,6 +47,23 @@ Eigen::Isometry3d cameraPose(const StampedPose& body, const Eigen::Isometry3d& T
   return T_w_b * T_b_c;
 }
 
+// With a real IMU, groundtruth.tum is the real EuRoC ground truth, not the spline the images
+// were rendered along (they differ by up to 1 degree), so the truth here would be wrong.
+void requireRenderedGroundTruth(const std::string& seq) {
+  const fs::path info = fs::path(seq) / "sim_info.yaml";
+  std::ifstream in(info);
+  if (!in) throw Error("cannot read " + info.string() + ": not a rendered sequence?");
+  const std::string key = "#   imu: ";
+  for (std::string line; std::getline(in, line);)
+    if (line.rfind(key, 0) == 0) {
+      if (line.rfind(key + "synthetic", 0) == 0) return;
+      throw Error(info.string() + " says '" + line.substr(4) +
+                  "': groundtruth.tum is then the real ground truth, not the trajectory the "
+                  "images were rendered along; use a sequence with the synthetic IMU");
+    }
+  throw Error(info.string() + " has no '" + key + "' line: not a rendered sequence?");
+}
+
 double median(std::vector<double> v) {
   if (v.empty()) return 0;
   std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
@@ -81,6 +98,7 @@ int main(int argc, char** argv) {
     const std::string out_dir = args.get("out");
     if (!out_dir.empty()) fs::create_directories(out_dir);
 
+    requireRenderedGroundTruth(seq);
     const EurocDataset data(seq);
     const Trajectory gt = readTrajectory((fs::path(seq) / "groundtruth.tum").string());
     const sim::SceneFile scene = sim::loadSequenceScene(seq);
