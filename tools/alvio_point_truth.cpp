@@ -143,6 +143,7 @@ int main(int argc, char** argv) {
         std::vector<double> flows;
         Eigen::Vector2d sum_err = Eigen::Vector2d::Zero();
         double sum_along = 0, sum_across = 0;
+        int within_3px = 0;  // the means leave out errors of 3 px and more (wrong tracks)
         std::vector<PointObservation> kept;
         for (PointObservation& o : frame.points) {
           TrackTruth& tt = tracks[o.id];
@@ -171,6 +172,7 @@ int main(int argc, char** argv) {
             all_errors.push_back(err.norm());
             flows.push_back(flow.norm());
             if (err.norm() < 3.0) {
+              ++within_3px;
               sum_err += err;
               if (flow.norm() > 1e-6) {
                 const Eigen::Vector2d f = flow.normalized();
@@ -198,7 +200,7 @@ int main(int argc, char** argv) {
           frame.points = kept;
         }
         if (errors_csv.is_open() && !errs.empty()) {
-          const double n = static_cast<double>(errs.size());
+          const double n = std::max(1, within_3px);
           errors_csv << std::fixed << std::setprecision(4) << frame.t() << ',' << errs.size() << ','
                      << median(errs) << ',' << sum_along / n << ',' << sum_across / n << ','
                      << sum_err.x() / n << ',' << sum_err.y() / n << ',' << median(flows) << '\n';
