@@ -43,11 +43,13 @@ TEST(SimTruth, SceneOfASequenceIsCheckedAgainstItsEdges) {
   EXPECT_NEAR((back[3].b - hall.scene.edges()[3].b).norm(), 0.0, 1e-6);
   std::ofstream(dir + "/sim_info.yaml") << "# Written by the alvio simulator.\n"
                                         << "#   scene: plain_room.yaml 0123456789abcdef\n"
+                                        << "#   imu: real 7f320d242e19fa62\n"
                                         << "#   start: 0 still: -1 seed: 1 texture: poor\n"
                                         << "frames: 3\n";
   EXPECT_EQ(sim::sceneNameFromSimInfo(dir + "/sim_info.yaml"), "plain_room.yaml");
   EXPECT_EQ(sim::textureDensityFromSimInfo(dir + "/sim_info.yaml"),
             sim::parseTextureDensity("poor"));
+  EXPECT_EQ(sim::imuModeFromSimInfo(dir + "/sim_info.yaml"), "real");
   EXPECT_EQ(sim::loadSequenceScene(dir).scene.edges().size(), back.size());
   // The sequence was rendered in another scene: refuse to score against this one.
   EXPECT_THROW(sim::loadSequenceScene(dir, "corridor"), Error);

@@ -35,6 +35,10 @@ double textureDensityFromSimInfo(const std::string& sim_info_path) {
       headerValue(sim_info_path, std::regex(R"(\stexture:\s+(\S+))"), "'texture:' value"));
 }
 
+std::string imuModeFromSimInfo(const std::string& sim_info_path) {
+  return headerValue(sim_info_path, std::regex(R"(^#\s+imu:\s+(\S+))"), "'# imu:' line");
+}
+
 SceneFile loadSequenceScene(const std::string& sequence_dir, const std::string& scene_override) {
   const std::filesystem::path dir(sequence_dir);
   const std::string name = scene_override.empty()

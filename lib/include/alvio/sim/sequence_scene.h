@@ -18,6 +18,10 @@ std::string sceneNameFromSimInfo(const std::string& sim_info_path);
 /// as parseTextureDensity reads it); throws alvio::Error when the header has none.
 double textureDensityFromSimInfo(const std::string& sim_info_path);
 
+/// The IMU the sequence was rendered with (`imu:` in sim_info.yaml's header: synthetic, real,
+/// or a data.csv path); throws alvio::Error when the header has none.
+std::string imuModeFromSimInfo(const std::string& sim_info_path);
+
 /// Load the scene of the sequence in `sequence_dir` (or `scene_override`, a name or path, when
 /// not empty) and check that its edges are those of `sequence_dir`/scene_edges.csv (same IDs,
 /// endpoints within 1e-5 m). Throws alvio::Error on any mismatch.
