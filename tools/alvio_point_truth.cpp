@@ -20,25 +20,19 @@
 #include "alvio/camera/camera_model.h"
 #include "alvio/common/arg_parser.h"
 #include "alvio/common/error.h"
+#include "alvio/common/timing.h"
 #include "alvio/config/config.h"
-#include "alvio/estimator/estimator.h"
 #include "alvio/eval/trajectory_evaluation.h"
 #include "alvio/eval/trajectory_interpolation.h"
 #include "alvio/io/euroc_dataset.h"
 #include "alvio/io/trajectory_io.h"
-#include "alvio/pipeline/front_end.h"
+#include "alvio/pipeline/vio_pipeline.h"
 #include "alvio/sim/sequence_scene.h"
 
 using namespace alvio;
 namespace fs = std::filesystem;
 
 namespace {
-
-struct TrackTruth {
-  Eigen::Vector3d point_w;
-  Eigen::Vector2d last_xy;  // tracked position in the previous frame
-  bool valid = false;
-};
 
 Eigen::Isometry3d cameraPose(const StampedPose& body, const Eigen::Isometry3d& T_b_c) {
   Eigen::Isometry3d T_w_b = Eigen::Isometry3d::Identity();
@@ -50,24 +44,127 @@ Eigen::Isometry3d cameraPose(const StampedPose& body, const Eigen::Isometry3d& T
 // With a real IMU, groundtruth.tum is the real EuRoC ground truth, not the spline the images
 // were rendered along (they differ by up to 1 degree), so the truth here would be wrong.
 void requireRenderedGroundTruth(const std::string& seq) {
-  const fs::path info = fs::path(seq) / "sim_info.yaml";
-  std::ifstream in(info);
-  if (!in) throw Error("cannot read " + info.string() + ": not a rendered sequence?");
-  const std::string key = "#   imu: ";
-  for (std::string line; std::getline(in, line);)
-    if (line.rfind(key, 0) == 0) {
-      if (line.rfind(key + "synthetic", 0) == 0) return;
-      throw Error(info.string() + " says '" + line.substr(4) +
-                  "': groundtruth.tum is then the real ground truth, not the trajectory the "
-                  "images were rendered along; use a sequence with the synthetic IMU");
-    }
-  throw Error(info.string() + " has no '" + key + "' line: not a rendered sequence?");
+  const std::string info = (fs::path(seq) / "sim_info.yaml").string();
+  const std::string imu = sim::imuModeFromSimInfo(info);
+  if (imu != "synthetic")
+    throw Error(info + " says 'imu: " + imu +
+                "': groundtruth.tum is then the real ground truth, not the trajectory the "
+                "images were rendered along; use a sequence with the synthetic IMU");
 }
 
-double median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
+struct PointTruthOptions {
+  bool oracle = false;
+  double oracle_noise_px = 0;
+  double drop_px = 0;  // 0: keep all
+};
+
+// Scores each frame's tracked points against the scene and, in the oracle and drop modes,
+// changes what the estimator is fed. Writes the two CSV files when given an output folder.
+class PointTruth {
+ public:
+  PointTruth(const PointTruthOptions& options, const sim::Scene& scene, const CameraModel& camera,
+             const Eigen::Isometry3d& T_b_c, const std::string& out_dir)
+      : options_(options), scene_(scene), camera_(camera), T_b_c_(T_b_c) {
+    if (out_dir.empty()) return;
+    errors_csv_.open((fs::path(out_dir) / "point_errors.csv").string());
+    errors_csv_ << "t,points,median_err_px,mean_along_flow_px,mean_across_flow_px,"
+                   "mean_err_x_px,mean_err_y_px,median_flow_px_per_frame\n";
+    obs_csv_.open((fs::path(out_dir) / "point_observations.csv").string());
+    obs_csv_ << "t,id,age,u,v,err_x_px,err_y_px,flow_x_px,flow_y_px,depth_m\n";
+  }
+
+  void process(const StampedPose& body, FeatureFrame* frame);
+  const std::vector<double>& errors() const { return all_errors_; }
+
+ private:
+  struct TrackTruth {
+    Eigen::Vector3d point_w;
+    Eigen::Vector2d last_xy;  // tracked position in the previous frame
+    bool valid = false;
+  };
+
+  PointTruthOptions options_;
+  const sim::Scene& scene_;
+  const CameraModel& camera_;
+  Eigen::Isometry3d T_b_c_;
+  std::mt19937 rng_{7};
+  std::normal_distribution<double> noise_{0.0, 1.0};
+  std::unordered_map<int, TrackTruth> tracks_;
+  std::vector<double> all_errors_;
+  std::ofstream errors_csv_, obs_csv_;
+};
+
+void PointTruth::process(const StampedPose& body, FeatureFrame* frame) {
+  const bool filter = options_.oracle || options_.drop_px > 0;
+  const Eigen::Isometry3d T_w_c = cameraPose(body, T_b_c_);
+  const Eigen::Isometry3d T_c_w = T_w_c.inverse();
+  const double fx = camera_.fx();
+  std::vector<double> errs;
+  std::vector<double> flows;
+  Eigen::Vector2d sum_err = Eigen::Vector2d::Zero();
+  double sum_along = 0, sum_across = 0;
+  int within_3px = 0;  // the means leave out errors of 3 px and more (wrong tracks)
+  std::vector<PointObservation> kept;
+  for (const PointObservation& o : frame->points) {
+    TrackTruth& tt = tracks_[o.id];
+    if (o.track_count == 1 || !tt.valid) {
+      const Eigen::Vector3d ray =
+          (T_w_c.linear() * Eigen::Vector3d(o.xy.x(), o.xy.y(), 1)).normalized();
+      const auto hit = scene_.intersect(T_w_c.translation(), ray);
+      tt.valid = hit.has_value() && o.track_count == 1;
+      if (tt.valid) tt.point_w = T_w_c.translation() + hit->t * ray;
+      tt.last_xy = o.xy;
+      continue;
+    }
+    const Eigen::Vector2d flow = (o.xy - tt.last_xy) * fx;
+    tt.last_xy = o.xy;
+    const Eigen::Vector3d p_c = T_c_w * tt.point_w;
+    if (p_c.z() <= 0.05) continue;
+    const Eigen::Vector2d xy_true = p_c.head<2>() / p_c.z();
+    const Eigen::Vector2d err = (o.xy - xy_true) * fx;
+    const bool visible = scene_.isVisible(tt.point_w, T_w_c.translation(), 0.01);
+    if (visible) {
+      if (obs_csv_.is_open())
+        obs_csv_ << std::fixed << std::setprecision(4) << frame->t() << ',' << o.id << ','
+                 << o.track_count << ',' << o.px.x() << ',' << o.px.y() << ',' << err.x() << ','
+                 << err.y() << ',' << flow.x() << ',' << flow.y() << ',' << p_c.z() << '\n';
+      errs.push_back(err.norm());
+      all_errors_.push_back(err.norm());
+      flows.push_back(flow.norm());
+      if (err.norm() < 3.0) {
+        ++within_3px;
+        sum_err += err;
+        if (flow.norm() > 1e-6) {
+          const Eigen::Vector2d f = flow.normalized();
+          sum_along += err.dot(f);
+          sum_across += f.x() * err.y() - f.y() * err.x();
+        }
+      }
+    }
+    if (options_.oracle) {
+      if (!visible) continue;
+      PointObservation c = o;
+      c.xy = xy_true + Eigen::Vector2d(noise_(rng_), noise_(rng_)) * options_.oracle_noise_px / fx;
+      c.px = camera_.distort(c.xy);
+      if (camera_.inImage(c.px)) kept.push_back(c);
+    } else if (options_.drop_px > 0 && visible && err.norm() < options_.drop_px) {
+      kept.push_back(o);
+    }
+  }
+  if (filter) {
+    // A new track's first observation is exact by construction (its point was cast through
+    // it).
+    for (const PointObservation& o : frame->points)
+      if (o.track_count == 1 && tracks_[o.id].valid) kept.push_back(o);
+    frame->points = std::move(kept);
+  }
+  if (errors_csv_.is_open() && !errs.empty()) {
+    const double n = std::max(1, within_3px);
+    errors_csv_ << std::fixed << std::setprecision(4) << frame->t() << ',' << errs.size() << ','
+                << percentile(errs, 50) << ',' << sum_along / n << ',' << sum_across / n << ','
+                << sum_err.x() / n << ',' << sum_err.y() / n << ',' << percentile(flows, 50)
+                << '\n';
+  }
 }
 
 }  // namespace
@@ -91,9 +188,6 @@ int main(int argc, char** argv) {
     const std::string seq = positional[0];
     Config config = Config::load(args.isSet("config") ? args.get("config") : Config::defaultPath());
     if (args.isSet("no-lines")) config.estimator.use_lines = false;
-    const bool oracle = args.isSet("oracle");
-    const double oracle_noise = args.getDouble("oracle-noise-px");
-    const double drop_px = args.getDouble("drop-px");
     const int max_frames = args.getInt("frames");
     const std::string out_dir = args.get("out");
     if (!out_dir.empty()) fs::create_directories(out_dir);
@@ -102,27 +196,12 @@ int main(int argc, char** argv) {
     const EurocDataset data(seq);
     const Trajectory gt = readTrajectory((fs::path(seq) / "groundtruth.tum").string());
     const sim::SceneFile scene = sim::loadSequenceScene(seq);
-    FrontEnd front_end(config);
-    Estimator estimator(config.estimator, config.camera, config.imu);
-    const CameraModel& camera = front_end.camera();
-    const Eigen::Isometry3d& T_b_c = config.camera.T_b_c;
-    std::mt19937 rng(7);
-    std::normal_distribution<double> noise(0.0, 1.0);
+    VioPipeline pipeline(config);
+    PointTruth truth(
+        {args.isSet("oracle"), args.getDouble("oracle-noise-px"), args.getDouble("drop-px")},
+        scene.scene, pipeline.camera(), config.camera.T_b_c, out_dir);
 
-    std::unordered_map<int, TrackTruth> tracks;
     Trajectory estimate;
-    std::ofstream errors_csv;
-    if (!out_dir.empty()) {
-      errors_csv.open((fs::path(out_dir) / "point_errors.csv").string());
-      errors_csv << "t,points,median_err_px,mean_along_flow_px,mean_across_flow_px,"
-                    "mean_err_x_px,mean_err_y_px,median_flow_px_per_frame\n";
-    }
-    std::vector<double> all_errors;
-    std::ofstream obs_csv;
-    if (!out_dir.empty()) {
-      obs_csv.open((fs::path(out_dir) / "point_observations.csv").string());
-      obs_csv << "t,id,age,u,v,err_x_px,err_y_px,flow_x_px,flow_y_px,depth_m\n";
-    }
     std::size_t next_imu = 0;
     const auto& imu = data.imu();
     int frame_index = 0;
@@ -130,92 +209,18 @@ int main(int argc, char** argv) {
       if (max_frames > 0 && frame_index >= max_frames) break;
       ++frame_index;
       while (next_imu < imu.size() && imu[next_imu].t_ns <= rec.t_ns)
-        estimator.addImu(imu[next_imu++]);
-      if (next_imu < imu.size()) estimator.addImu(imu[next_imu++]);
+        pipeline.addImu(imu[next_imu++]);
+      if (next_imu < imu.size()) pipeline.addImu(imu[next_imu++]);
       const cv::Mat gray = cv::imread(rec.path, cv::IMREAD_GRAYSCALE);
       if (gray.empty()) throw Error("cannot read " + rec.path);
-      FeatureFrame frame = front_end.track(gray, rec.t_ns);
-      const std::optional<StampedPose> body = interpolatePose(gt, frame.t());
-      if (body) {
-        const Eigen::Isometry3d T_w_c = cameraPose(*body, T_b_c);
-        const Eigen::Isometry3d T_c_w = T_w_c.inverse();
-        std::vector<double> errs;
-        std::vector<double> flows;
-        Eigen::Vector2d sum_err = Eigen::Vector2d::Zero();
-        double sum_along = 0, sum_across = 0;
-        int within_3px = 0;  // the means leave out errors of 3 px and more (wrong tracks)
-        std::vector<PointObservation> kept;
-        for (PointObservation& o : frame.points) {
-          TrackTruth& tt = tracks[o.id];
-          if (o.track_count == 1 || !tt.valid) {
-            const Eigen::Vector3d ray = T_w_c.linear() * Eigen::Vector3d(o.xy.x(), o.xy.y(), 1);
-            const auto hit = scene.scene.intersect(T_w_c.translation(), ray.normalized());
-            tt.valid = hit.has_value() && o.track_count == 1;
-            if (tt.valid) tt.point_w = T_w_c.translation() + hit->t * ray.normalized();
-            tt.last_xy = o.xy;
-            if (!oracle && drop_px <= 0) kept.push_back(o);
-            continue;
-          }
-          const Eigen::Vector2d flow = (o.xy - tt.last_xy) * camera.fx();
-          tt.last_xy = o.xy;
-          const Eigen::Vector3d p_c = T_c_w * tt.point_w;
-          if (p_c.z() <= 0.05) continue;
-          const Eigen::Vector2d xy_true = p_c.head<2>() / p_c.z();
-          const Eigen::Vector2d err = (o.xy - xy_true) * camera.fx();
-          const bool visible = scene.scene.isVisible(tt.point_w, T_w_c.translation(), 0.01);
-          if (visible && obs_csv.is_open())
-            obs_csv << std::fixed << std::setprecision(4) << frame.t() << ',' << o.id << ','
-                    << o.track_count << ',' << o.px.x() << ',' << o.px.y() << ',' << err.x() << ','
-                    << err.y() << ',' << flow.x() << ',' << flow.y() << ',' << p_c.z() << '\n';
-          if (visible) {
-            errs.push_back(err.norm());
-            all_errors.push_back(err.norm());
-            flows.push_back(flow.norm());
-            if (err.norm() < 3.0) {
-              ++within_3px;
-              sum_err += err;
-              if (flow.norm() > 1e-6) {
-                const Eigen::Vector2d f = flow.normalized();
-                sum_along += err.dot(f);
-                sum_across += f.x() * err.y() - f.y() * err.x();
-              }
-            }
-          }
-          if (oracle) {
-            if (!visible) continue;
-            PointObservation c = o;
-            c.xy = xy_true + Eigen::Vector2d(noise(rng), noise(rng)) * oracle_noise / camera.fx();
-            c.px = camera.distort(c.xy);
-            if (!camera.inImage(c.px)) continue;
-            kept.push_back(c);
-          } else if (drop_px <= 0 || (visible && err.norm() < drop_px)) {
-            kept.push_back(o);
-          }
-        }
-        if (oracle || drop_px > 0) {
-          // A new track's first observation is exact by construction (its point was cast
-          // through it).
-          for (const PointObservation& o : frame.points)
-            if (o.track_count == 1 && tracks[o.id].valid) kept.push_back(o);
-          frame.points = kept;
-        }
-        if (errors_csv.is_open() && !errs.empty()) {
-          const double n = std::max(1, within_3px);
-          errors_csv << std::fixed << std::setprecision(4) << frame.t() << ',' << errs.size() << ','
-                     << median(errs) << ',' << sum_along / n << ',' << sum_across / n << ','
-                     << sum_err.x() / n << ',' << sum_err.y() / n << ',' << median(flows) << '\n';
-        }
-      }
-      const int resets_before = estimator.resetCount();
-      const bool has_pose = estimator.addFrame(frame);
-      // As VioPipeline: after a reset the tracks start again.
-      if (estimator.resetCount() != resets_before) front_end.resetPoints();
-      if (has_pose) {
-        const BodyState st = estimator.latestState();
+      const PipelineOutput out = pipeline.addImage(gray, rec.t_ns, [&](FeatureFrame* frame) {
+        if (const auto body = interpolatePose(gt, frame->t())) truth.process(*body, frame);
+      });
+      if (out.has_pose) {
         StampedPose p;
-        p.t = st.t;
-        p.p = st.p;
-        p.q = st.q;
+        p.t = out.state.t;
+        p.p = out.state.p;
+        p.q = out.state.q;
         estimate.push_back(p);
       }
       if (frame_index % 200 == 0)
@@ -226,9 +231,10 @@ int main(int argc, char** argv) {
                   " frames (not initialised): nothing to evaluate");
     const EvaluationResult e = evaluateTrajectory(estimate, gt, EvaluationOptions());
     std::cout << std::fixed << std::setprecision(4) << "frames " << frame_index << " poses "
-              << estimate.size() << " resets " << estimator.resetCount() << " ATE "
-              << e.ate_translation_m.rmse << " m; point error median " << median(all_errors)
-              << " px over " << all_errors.size() << " observations\n";
+              << estimate.size() << " resets " << pipeline.estimator().resetCount() << " ATE "
+              << e.ate_translation_m.rmse << " m; point error median "
+              << percentile(truth.errors(), 50) << " px over " << truth.errors().size()
+              << " observations\n";
     if (!out_dir.empty())
       writeTumTrajectory((fs::path(out_dir) / "trajectory.tum").string(), estimate);
     return 0;

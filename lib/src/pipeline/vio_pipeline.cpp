@@ -19,7 +19,8 @@ bool VioPipeline::addImu(const ImuSample& sample) {
   return true;
 }
 
-PipelineOutput VioPipeline::addImage(const cv::Mat& gray, int64_t t_ns) {
+PipelineOutput VioPipeline::addImage(const cv::Mat& gray, int64_t t_ns,
+                                     const std::function<void(FeatureFrame*)>& edit_features) {
   PipelineOutput out;
   out.timing.t = t_ns * 1e-9;
   if (staleStamp(t_ns, last_image_ns_)) {
@@ -32,6 +33,7 @@ PipelineOutput VioPipeline::addImage(const cv::Mat& gray, int64_t t_ns) {
   }
   last_image_ns_ = t_ns;
   out.features = front_end_.track(gray, t_ns, &out.timing);
+  if (edit_features) edit_features(&out.features);
   const int resets_before = estimator_.resetCount();
   out.has_pose = estimator_.addFrame(out.features, &out.timing);
   // After a reset the tracks start again, so re-initialisation sees fresh parallax.

@@ -3,6 +3,7 @@
 // out. Used by the offline runner; the nodelets split the same parts across
 // the tracker and estimator nodelets.
 
+#include <functional>
 #include <memory>
 #include <opencv2/core.hpp>
 #include <vector>
@@ -43,7 +44,10 @@ class VioPipeline {
   /// Track and estimate one 8-bit grey image. IMU up to (and one sample beyond) its time
   /// should have been added. An image not after the previous one is dropped (a stamp
   /// going back would run the tracker and the IMU integration backwards).
-  PipelineOutput addImage(const cv::Mat& gray, int64_t t_ns);
+  /// `edit_features`, when given, may change the tracked features before the estimator sees
+  /// them (alvio_point_truth replaces them with their true projections).
+  PipelineOutput addImage(const cv::Mat& gray, int64_t t_ns,
+                          const std::function<void(FeatureFrame*)>& edit_features = {});
 
   std::size_t droppedImages() const { return images_late_.total(); }
 
