@@ -1,10 +1,14 @@
-// The corner detector returns exactly cv::goodFeaturesToTrack's corners, in its order, on
-// textured, tied and masked images, and on real EuRoC frames when the shared data is here.
+// The corner detector returns cv::goodFeaturesToTrack's corners, in its order, on textured,
+// tied and masked images, and on real EuRoC frames when the shared data is here. Its response
+// is summed exactly where OpenCV sums floats: two candidates whose OpenCV responses are
+// within its rounding may swap places, nothing else may differ.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <string>
 
 #include "alvio/frontend/corner_detector.h"
 #include "test_support.h"
@@ -38,15 +42,35 @@ cv::Mat discMask(cv::Size size, int discs, int radius, int seed) {
   return mask;
 }
 
+// OpenCV's responses agree within their rounding (relative 3e-5 measured; 1e-4 allowed).
+bool nearlyTied(const cv::Mat& response, cv::Point2f a, cv::Point2f b) {
+  const float ra = response.at<float>(cvRound(a.y), cvRound(a.x));
+  const float rb = response.at<float>(cvRound(b.y), cvRound(b.x));
+  return std::abs(ra - rb) <= 1e-4 * std::max(std::abs(ra), std::abs(rb));
+}
+
 void expectSameAsOpenCv(CornerDetector* detector, const cv::Mat& img, int max_corners,
                         double quality, double min_distance, const cv::Mat& mask) {
   std::vector<cv::Point2f> expected;
   cv::goodFeaturesToTrack(img, expected, max_corners, quality, min_distance, mask);
   const std::vector<cv::Point2f> got =
       detector->detect(img, max_corners, quality, min_distance, mask);
-  ASSERT_EQ(got.size(), expected.size())
-      << "max " << max_corners << ", distance " << min_distance << ", mask " << !mask.empty();
-  for (std::size_t i = 0; i < got.size(); ++i) EXPECT_EQ(got[i], expected[i]) << "corner " << i;
+  const std::string where = "max " + std::to_string(max_corners) + ", distance " +
+                            std::to_string(min_distance) + ", mask " +
+                            (mask.empty() ? "no" : "yes");
+  ASSERT_EQ(got.size(), expected.size()) << where;
+  cv::Mat response;
+  cv::cornerMinEigenVal(img, response, 3, 3);
+  std::size_t differing = 0;
+  for (std::size_t i = 0; i < got.size(); ++i) {
+    if (got[i] == expected[i]) continue;
+    ++differing;
+    EXPECT_TRUE(nearlyTied(response, got[i], expected[i]))
+        << where << ": corner " << i << " is " << got[i] << ", OpenCV's " << expected[i];
+  }
+  // A swap of two near-ties shows up as two differing places; spacing can carry it a little
+  // further. Anything more is not rounding.
+  EXPECT_LE(differing, 2 + got.size() / 200) << where;
 }
 }  // namespace
 

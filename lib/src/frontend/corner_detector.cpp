@@ -1,7 +1,7 @@
 #include "alvio/frontend/corner_detector.h"
 
 #include <algorithm>
-#include <opencv2/imgproc.hpp>
+#include <opencv2/core.hpp>
 
 namespace alvio {
 
@@ -16,30 +16,38 @@ std::vector<cv::Point2f> CornerDetector::detect(const cv::Mat& image, int max_co
                                                 const cv::Mat& mask) {
   CV_Assert(image.type() == CV_8UC1 && max_corners > 0 && quality_level > 0 && min_distance >= 0);
   CV_Assert(mask.empty() || (mask.type() == CV_8UC1 && mask.size() == image.size()));
-  // The response map, thresholded and dilated as OpenCV does: a candidate is a non-zero
-  // local maximum of its 3x3 neighbourhood.
-  cv::cornerMinEigenVal(image, response_, 3, 3);
+  // OpenCV thresholds the response at quality_level times its maximum inside the mask and
+  // dilates it; a candidate is a non-zero pixel equal to its dilation, inside the mask and one
+  // pixel from the border. That is: above the threshold and above zero, and the largest of its
+  // 3x3 block (a thresholded neighbour is zero, weaker by then). One pass over the image
+  // instead of five, candidates in the same raster order.
+  response_calculator_.compute(image, &response_);
   double max_response = 0;
   cv::minMaxLoc(response_, nullptr, &max_response, nullptr, nullptr, mask);
-  cv::threshold(response_, response_, max_response * quality_level, 0, cv::THRESH_TOZERO);
-  cv::dilate(response_, dilated_, cv::Mat());
-
-  // Candidates: non-zero local maxima inside the mask, one pixel away from the border, in
-  // raster order (vectorised comparisons, then one pass over the survivors).
+  const float threshold = static_cast<float>(max_response * quality_level);  // as cv::threshold
   const int w = image.cols, h = image.rows;
-  candidates_.clear();
-  if (w > 2 && h > 2) {
-    const cv::Rect inner(1, 1, w - 2, h - 2);
-    cv::compare(response_(inner), dilated_(inner), is_candidate_, cv::CMP_EQ);
-    cv::compare(response_(inner), 0, nonzero_, cv::CMP_GT);  // thresholded: never negative
-    cv::bitwise_and(is_candidate_, nonzero_, is_candidate_);
-    if (!mask.empty()) cv::bitwise_and(is_candidate_, mask(inner), is_candidate_);
-    cv::findNonZero(is_candidate_, locations_);
-    for (const cv::Point& p : locations_) {
-      const int x = p.x + 1, y = p.y + 1;
-      candidates_.push_back({response_.at<float>(y, x), y * w + x});
+  // Branch-free: every inner pixel is written, the next write moves on only past a candidate.
+  const std::size_t room = static_cast<std::size_t>(std::max(0, w - 2)) * std::max(0, h - 2);
+  if (candidates_.size() < room) candidates_.resize(room);
+  column_max_.resize(w);
+  float* __restrict column_max = column_max_.data();
+  Candidate* out = candidates_.data();
+  for (int y = 1; y < h - 1; ++y) {
+    const float* __restrict above = response_.ptr<float>(y - 1);
+    const float* __restrict row = response_.ptr<float>(y);
+    const float* __restrict below = response_.ptr<float>(y + 1);
+    for (int x = 0; x < w; ++x) column_max[x] = std::max(std::max(above[x], row[x]), below[x]);
+    const uchar* m = mask.empty() ? nullptr : mask.ptr<uchar>(y);
+    for (int x = 1; x < w - 1; ++x) {
+      const float v = row[x];
+      const float block_max =
+          std::max(std::max(column_max[x - 1], column_max[x]), column_max[x + 1]);
+      const bool keep = (v > threshold) & (v > 0) & (v >= block_max) & (!m || m[x] != 0);
+      *out = {v, y * w + x};
+      out += keep;
     }
   }
+  const auto candidates_end = candidates_.begin() + (out - candidates_.data());
   const auto stronger = [](const Candidate& a, const Candidate& b) {
     return a.response > b.response || (a.response == b.response && a.index > b.index);
   };
@@ -67,11 +75,10 @@ std::vector<cv::Point2f> CornerDetector::detect(const cv::Mat& image, int max_co
 
   std::vector<cv::Point2f> corners;
   auto begin = candidates_.begin();
-  while (begin != candidates_.end() && static_cast<int>(corners.size()) < max_corners) {
-    const std::ptrdiff_t block = std::min<std::ptrdiff_t>(kBlock, candidates_.end() - begin);
+  while (begin != candidates_end && static_cast<int>(corners.size()) < max_corners) {
+    const std::ptrdiff_t block = std::min<std::ptrdiff_t>(kBlock, candidates_end - begin);
     const auto block_end = begin + block;
-    if (block_end != candidates_.end())
-      std::nth_element(begin, block_end, candidates_.end(), stronger);
+    if (block_end != candidates_end) std::nth_element(begin, block_end, candidates_end, stronger);
     std::sort(begin, block_end, stronger);
     for (auto it = begin; it != block_end && static_cast<int>(corners.size()) < max_corners; ++it) {
       const int x = it->index % w, y = it->index / w;
