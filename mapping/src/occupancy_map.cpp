@@ -1,6 +1,7 @@
 #include "alvio/mapping/occupancy_map.h"
 
 #include <algorithm>
+#include <cstdint>
 #include <limits>
 
 #include "alvio/common/error.h"
@@ -45,17 +46,20 @@ OccupancyMap::OccupancyMap(const OccupancyMapOptions& options)
 namespace {
 constexpr double kMaxRayLength_m = 100.0;
 
-// The leaf at full depth for `key`, or nullptr where it does not exist yet or lies inside a
-// pruned node (there OcTree::updateNode has to create or expand nodes).
-octomap::OcTreeNode* fullDepthLeaf(const octomap::OcTree& tree, const octomap::OcTreeKey& key) {
-  octomap::OcTreeNode* node = tree.getRoot();
-  if (!node) return nullptr;
-  for (int level = static_cast<int>(tree.getTreeDepth()) - 1; level >= 0; --level) {
-    const unsigned int child = octomap::computeChildIdx(key, level);
-    if (!tree.nodeChildExists(node, child)) return nullptr;
-    node = tree.getNodeChild(node, child);
-  }
-  return node;
+// Bit i of v moved to bit 3i.
+uint64_t spreadBits(uint16_t v) {
+  uint64_t x = v;
+  x = (x | (x << 16)) & 0x0000FF0000FFULL;
+  x = (x | (x << 8)) & 0x00F00F00F00FULL;
+  x = (x | (x << 4)) & 0x0C30C30C30C3ULL;
+  x = (x | (x << 2)) & 0x249249249249ULL;
+  return x;
+}
+
+// The key's path from the root: at tree depth d the three bits at 3 (15 - d) are the child
+// index OcTree::computeChildIdx gives. Sorted codes visit the leaves depth first.
+uint64_t pathCode(const octomap::OcTreeKey& key) {
+  return spreadBits(key.k[0]) | (spreadBits(key.k[1]) << 1) | (spreadBits(key.k[2]) << 2);
 }
 }  // namespace
 
@@ -93,20 +97,51 @@ void OccupancyMap::insert(const Eigen::Vector3d& origin_w,
       cloud.push_back(p.x(), p.y(), p.z());
   // As OcTree::insertPointCloud with lazy evaluation and discretisation (one ray per end voxel,
   // which matters for densely sampled lines), but an existing leaf is updated where it is
-  // found: updateNode searches for it and then descends to it a second time. Same map, same
-  // order of updates.
+  // found: updateNode searches for it and then descends to it a second time. The voxels are
+  // visited in the tree's depth-first order, each descent starting where the last one's path
+  // parts from it: neighbouring voxels share most of their path. Same map: the sets are
+  // disjoint and each voxel's update depends on that voxel alone.
   octomap::KeySet free_cells, occupied_cells;
   tree_->computeDiscreteUpdate(cloud, origin, free_cells, occupied_cells, options_.max_range);
-  const bool in_place = !tree_->isChangeDetectionEnabled();
-  auto update = [&](const octomap::OcTreeKey& key, bool occupied) {
-    octomap::OcTreeNode* leaf = in_place ? fullDepthLeaf(*tree_, key) : nullptr;
-    if (leaf)
-      tree_->updateNodeLogOdds(leaf, occupied ? tree_->getProbHitLog() : tree_->getProbMissLog());
-    else
-      tree_->updateNode(key, occupied, /*lazy_eval=*/true);
-  };
-  for (const octomap::OcTreeKey& key : free_cells) update(key, false);
-  for (const octomap::OcTreeKey& key : occupied_cells) update(key, true);
+  updates_.clear();
+  updates_.reserve(free_cells.size() + occupied_cells.size());
+  for (const octomap::OcTreeKey& key : free_cells) updates_.push_back({pathCode(key), key, false});
+  for (const octomap::OcTreeKey& key : occupied_cells)
+    updates_.push_back({pathCode(key), key, true});
+  std::sort(updates_.begin(), updates_.end(),
+            [](const VoxelUpdate& a, const VoxelUpdate& b) { return a.code < b.code; });
+  const int depth = static_cast<int>(tree_->getTreeDepth());
+  const bool in_place = !tree_->isChangeDetectionEnabled() && depth == 16;
+  // path[d]: the node at depth d on the last key's path, valid for d <= valid.
+  octomap::OcTreeNode* path[17];
+  int valid = -1;
+  uint64_t last_code = 0;
+  for (const VoxelUpdate& u : updates_) {
+    octomap::OcTreeNode* leaf = nullptr;
+    if (in_place && tree_->getRoot()) {
+      path[0] = tree_->getRoot();
+      // Depths whose child index matches the last key's: 16 minus the highest differing group.
+      const uint64_t differ = u.code ^ last_code;
+      const int shared = differ ? 15 - (63 - __builtin_clzll(differ)) / 3 : 16;
+      int d = std::min(valid < 0 ? 0 : valid, shared);
+      octomap::OcTreeNode* node = path[d];
+      for (; d < 16; ++d) {
+        const unsigned int child = (u.code >> (3 * (15 - d))) & 7u;
+        if (!tree_->nodeChildExists(node, child)) break;
+        node = tree_->getNodeChild(node, child);
+        path[d + 1] = node;
+      }
+      valid = d;
+      if (d == 16) leaf = node;
+    }
+    last_code = u.code;
+    if (leaf) {
+      tree_->updateNodeLogOdds(leaf, u.occupied ? tree_->getProbHitLog() : tree_->getProbMissLog());
+    } else {
+      tree_->updateNode(u.key, u.occupied, /*lazy_eval=*/true);
+      valid = 0;  // nodes were created or expanded below the root
+    }
+  }
   inner_nodes_stale_ = true;
 }
 

@@ -84,9 +84,16 @@ class OccupancyMap {
   /// costs more than it saves, and the unpruned tree is only ~1 % larger.
   void syncInnerNodes() const;
 
+  struct VoxelUpdate {
+    uint64_t code;  ///< the key's path from the root, three bits per depth
+    octomap::OcTreeKey key;
+    bool occupied;
+  };
+
   OccupancyMapOptions options_;
   std::unique_ptr<octomap::OcTree> tree_;
   mutable bool inner_nodes_stale_ = false;
+  std::vector<VoxelUpdate> updates_;  // one insertion's voxels, kept for its capacity
 };
 
 }  // namespace alvio
