@@ -103,6 +103,7 @@ int main(int argc, char** argv) {
     for (const std::string& dir : args.positional()) {
       if (!fs::exists(fs::path(dir) / "sim_stamp.txt"))
         throw Error(dir + ": no sim_stamp.txt (sequence incomplete or not simulated)");
+      sim::requireRenderedGroundTruth(dir);  // the true edges are projected from its poses
       const sim::SceneFile scene = sim::loadSequenceScene(dir, args.get("scene"));
       const EurocDataset dataset(dir);
       const Trajectory gt = readTrajectory((fs::path(dir) / "groundtruth.tum").string());

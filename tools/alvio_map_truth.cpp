@@ -52,6 +52,7 @@ int main(int argc, char** argv) {
     if (args.positional().size() != 2) throw Error("give RUN_DIR and SEQUENCE_DIR");
     const fs::path run = args.positional()[0], seq = args.positional()[1];
 
+    sim::requireRenderedGroundTruth(seq.string());  // the map is aligned through its poses
     // Alignment estimate -> truth from the trajectories.
     const Trajectory est = readTrajectory((run / "trajectory.tum").string());
     const Trajectory gt = readTrajectory((seq / "groundtruth.tum").string());

@@ -41,17 +41,6 @@ Eigen::Isometry3d cameraPose(const StampedPose& body, const Eigen::Isometry3d& T
   return T_w_b * T_b_c;
 }
 
-// With a real IMU, groundtruth.tum is the real EuRoC ground truth, not the spline the images
-// were rendered along (they differ by up to 1 degree), so the truth here would be wrong.
-void requireRenderedGroundTruth(const std::string& seq) {
-  const std::string info = (fs::path(seq) / "sim_info.yaml").string();
-  const std::string imu = sim::imuModeFromSimInfo(info);
-  if (imu != "synthetic")
-    throw Error(info + " says 'imu: " + imu +
-                "': groundtruth.tum is then the real ground truth, not the trajectory the "
-                "images were rendered along; use a sequence with the synthetic IMU");
-}
-
 struct PointTruthOptions {
   bool oracle = false;
   double oracle_noise_px = 0;
@@ -192,7 +181,7 @@ int main(int argc, char** argv) {
     const std::string out_dir = args.get("out");
     if (!out_dir.empty()) fs::create_directories(out_dir);
 
-    requireRenderedGroundTruth(seq);
+    sim::requireRenderedGroundTruth(seq);
     const EurocDataset data(seq);
     const Trajectory gt = readTrajectory((fs::path(seq) / "groundtruth.tum").string());
     const sim::SceneFile scene = sim::loadSequenceScene(seq);
@@ -239,7 +228,7 @@ int main(int argc, char** argv) {
       writeTumTrajectory((fs::path(out_dir) / "trajectory.tum").string(), estimate);
     return 0;
   } catch (const std::exception& ex) {
-    std::cerr << "alvio_point_truth: " << ex.what() << "\n";
+    std::cerr << "alvio_point_truth: error: " << ex.what() << "\n";
     return 1;
   }
 }

@@ -50,9 +50,14 @@ TEST(SimTruth, SceneOfASequenceIsCheckedAgainstItsEdges) {
   EXPECT_EQ(sim::textureDensityFromSimInfo(dir + "/sim_info.yaml"),
             sim::parseTextureDensity("poor"));
   EXPECT_EQ(sim::imuModeFromSimInfo(dir + "/sim_info.yaml"), "real");
+  // A real IMU: groundtruth.tum is not the rendered trajectory, the truth tools refuse it.
+  EXPECT_THROW(sim::requireRenderedGroundTruth(dir), Error);
   EXPECT_EQ(sim::loadSequenceScene(dir).scene.edges().size(), back.size());
   // The sequence was rendered in another scene: refuse to score against this one.
   EXPECT_THROW(sim::loadSequenceScene(dir, "corridor"), Error);
+  std::ofstream(dir + "/sim_info.yaml") << "#   scene: plain_room.yaml 0123456789abcdef\n"
+                                        << "#   imu: synthetic\n";
+  EXPECT_NO_THROW(sim::requireRenderedGroundTruth(dir));
 }
 
 TEST(SimTruth, PoseInterpolation) {

@@ -39,6 +39,15 @@ std::string imuModeFromSimInfo(const std::string& sim_info_path) {
   return headerValue(sim_info_path, std::regex(R"(^#\s+imu:\s+(\S+))"), "'# imu:' line");
 }
 
+void requireRenderedGroundTruth(const std::string& sequence_dir) {
+  const std::string info = (std::filesystem::path(sequence_dir) / "sim_info.yaml").string();
+  const std::string imu = imuModeFromSimInfo(info);
+  if (imu != "synthetic")
+    throw Error(info + " says 'imu: " + imu +
+                "': groundtruth.tum is then the real ground truth, not the trajectory the "
+                "images were rendered along; use a sequence with the synthetic IMU");
+}
+
 SceneFile loadSequenceScene(const std::string& sequence_dir, const std::string& scene_override) {
   const std::filesystem::path dir(sequence_dir);
   const std::string name = scene_override.empty()

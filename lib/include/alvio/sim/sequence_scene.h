@@ -22,6 +22,12 @@ double textureDensityFromSimInfo(const std::string& sim_info_path);
 /// or a data.csv path); throws alvio::Error when the header has none.
 std::string imuModeFromSimInfo(const std::string& sim_info_path);
 
+/// Throws alvio::Error unless the sequence in `sequence_dir` was rendered with the synthetic
+/// IMU. With a real IMU, groundtruth.tum is the real EuRoC ground truth, not the spline the
+/// images were rendered along (up to 1 degree apart): truth projected into the images from it
+/// would be wrong.
+void requireRenderedGroundTruth(const std::string& sequence_dir);
+
 /// Load the scene of the sequence in `sequence_dir` (or `scene_override`, a name or path, when
 /// not empty) and check that its edges are those of `sequence_dir`/scene_edges.csv (same IDs,
 /// endpoints within 1e-5 m). Throws alvio::Error on any mismatch.
