@@ -50,4 +50,6 @@ TEST(ArgParser, ErrorsNameTheOption) {
             std::string::npos);
   EXPECT_NE(message({"--quiet"}).find("missing required option '--out'"), std::string::npos);
   EXPECT_NE(message({"--out"}).find("'--out' needs a value"), std::string::npos);
+  // The tools print "<program>: error: <message>": the message does not repeat the name.
+  EXPECT_EQ(message({"--bogus"}).find("prog"), std::string::npos);
 }

@@ -64,14 +64,14 @@ bool ArgParser::parse(int argc, char** argv) {
     }
     const auto it = specs_.find(name);
     if (it == specs_.end())
-      throw Error(program_ + ": unknown option '--" + name + "' (see --help)");
+      throw Error("unknown option '--" + name + "' (see --help)");
     if (it->second.is_flag) {
-      if (has_inline) throw Error(program_ + ": flag '--" + name + "' takes no value");
+      if (has_inline) throw Error("flag '--" + name + "' takes no value");
       values_[name] = "1";
       continue;
     }
     if (!has_inline) {
-      if (i + 1 >= argc) throw Error(program_ + ": option '--" + name + "' needs a value");
+      if (i + 1 >= argc) throw Error("option '--" + name + "' needs a value");
       value = argv[++i];
     }
     // A repeated option replaces the earlier value, except a list option, which collects.
@@ -83,7 +83,7 @@ bool ArgParser::parse(int argc, char** argv) {
   }
   for (const auto& [name, spec] : specs_)
     if (spec.required && !values_.count(name))
-      throw Error(program_ + ": missing required option '--" + name + "' (see --help)");
+      throw Error("missing required option '--" + name + "' (see --help)");
   return true;
 }
 
@@ -102,7 +102,7 @@ double ArgParser::getDouble(const std::string& name) const {
   char* end = nullptr;
   const double d = std::strtod(v.c_str(), &end);
   if (v.empty() || *end != '\0' || !std::isfinite(d))
-    throw Error(program_ + ": option '--" + name + "' needs a number, got '" + v + "'");
+    throw Error("option '--" + name + "' needs a number, got '" + v + "'");
   return d;
 }
 
@@ -111,7 +111,7 @@ int ArgParser::getInt(const std::string& name) const {
   char* end = nullptr;
   const long d = std::strtol(v.c_str(), &end, 10);
   if (v.empty() || *end != '\0')
-    throw Error(program_ + ": option '--" + name + "' needs an integer, got '" + v + "'");
+    throw Error("option '--" + name + "' needs an integer, got '" + v + "'");
   return static_cast<int>(d);
 }
 
