@@ -114,16 +114,17 @@ void OccupancyMap::insert(const Eigen::Vector3d& origin_w,
   const bool in_place = !tree_->isChangeDetectionEnabled() && depth == 16;
   // path[d]: the node at depth d on the last key's path, valid for d <= valid.
   octomap::OcTreeNode* path[17];
-  int valid = -1;
+  int valid = 0;
   uint64_t last_code = 0;
   for (const VoxelUpdate& u : updates_) {
     octomap::OcTreeNode* leaf = nullptr;
     if (in_place && tree_->getRoot()) {
       path[0] = tree_->getRoot();
-      // Depths whose child index matches the last key's: 16 minus the highest differing group.
+      // The depths where this key takes the same child as the last one: those above its
+      // highest differing 3-bit group.
       const uint64_t differ = u.code ^ last_code;
       const int shared = differ ? 15 - (63 - __builtin_clzll(differ)) / 3 : 16;
-      int d = std::min(valid < 0 ? 0 : valid, shared);
+      int d = std::min(valid, shared);
       octomap::OcTreeNode* node = path[d];
       for (; d < 16; ++d) {
         const unsigned int child = (u.code >> (3 * (15 - d))) & 7u;
