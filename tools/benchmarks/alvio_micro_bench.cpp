@@ -24,6 +24,7 @@
 #include "alvio/estimator/factors/imu_factor.h"
 #include "alvio/estimator/factors/point_projection_factor.h"
 #include "alvio/frontend/corner_detector.h"
+#include "alvio/frontend/min_eigen_response.h"
 #include "alvio/frontend/point_tracker.h"
 #include "alvio/geometry/line_projection_factor.h"
 #include "alvio/imu/imu_preintegration.h"
@@ -183,6 +184,21 @@ void BM_CornerDetection(benchmark::State& state) {
   state.counters["corners"] = static_cast<double>(n);
 }
 BENCHMARK(BM_CornerDetection)->Unit(benchmark::kMillisecond);
+
+// The Shi-Tomasi response alone, over the whole frame: OpenCV's and the detector's own.
+void BM_CornerResponseOpenCv(benchmark::State& state) {
+  const cv::Mat& image = framePair().a;
+  cv::Mat response;
+  for (auto _ : state) cv::cornerMinEigenVal(image, response, 3, 3);
+}
+BENCHMARK(BM_CornerResponseOpenCv)->Unit(benchmark::kMillisecond);
+void BM_CornerResponse(benchmark::State& state) {
+  const cv::Mat& image = framePair().a;
+  MinEigenResponse calculator;
+  cv::Mat response;
+  for (auto _ : state) calculator.compute(image, &response);
+}
+BENCHMARK(BM_CornerResponse)->Unit(benchmark::kMillisecond);
 
 // One frame interval of IMU at 200 Hz (10 midpoint steps with covariance propagation).
 void BM_ImuPreintegration(benchmark::State& state) {
