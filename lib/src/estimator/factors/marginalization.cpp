@@ -12,12 +12,15 @@
 namespace alvio {
 namespace {
 
-// Tangent-space Jacobian of one block from its ambient (row-major) Jacobian.
-Eigen::MatrixXd tangentJacobian(
+// Tangent-space Jacobian of one block from its ambient (row-major) Jacobian, into `J`
+// (whose storage is reused).
+void tangentJacobian(
     const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>& J_ambient,
-    const double* x, int size) {
-  if (size != 7) return J_ambient;
-  return J_ambient * posePlusJacobian(x);
+    const double* x, int size, Eigen::MatrixXd* J) {
+  if (size != 7)
+    *J = J_ambient;
+  else
+    J->noalias() = J_ambient * posePlusJacobian(x);
 }
 
 // Inverse left Jacobian of SO(3) at rotation vector phi: d Log(Exp(e) R) / de at e = 0.
@@ -108,32 +111,37 @@ bool MarginalizationInfo::marginalize() {
   for (double* b : kept) offset[b] = m + n, n += tangentSizeOf(size_of[b]);
   if (n == 0) return false;
 
-  // Gauss-Newton system of all factors at the current values.
+  // Gauss-Newton system of all factors at the current values. The per-factor matrices keep
+  // their storage from one factor to the next: most factors have the same shapes.
   Eigen::MatrixXd H = Eigen::MatrixXd::Zero(m + n, m + n);
   Eigen::VectorXd g = Eigen::VectorXd::Zero(m + n);
+  Eigen::VectorXd r;
+  std::vector<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> Ja;
+  std::vector<double*> jac_ptrs;
+  std::vector<Eigen::MatrixXd> Jt;
+  Eigen::MatrixXd Hab;
   for (const auto& f : factors_) {
     const int num_residuals = f.cost->num_residuals();
     const auto& sizes = f.cost->parameter_block_sizes();
-    Eigen::VectorXd r(num_residuals);
-    std::vector<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> Ja(
-        f.blocks.size());
-    std::vector<double*> jac_ptrs(f.blocks.size());
+    r.resize(num_residuals);
+    Ja.resize(f.blocks.size());
+    jac_ptrs.resize(f.blocks.size());
+    Jt.resize(f.blocks.size());
     for (std::size_t k = 0; k < f.blocks.size(); ++k) {
       Ja[k].resize(num_residuals, sizes[k]);
       jac_ptrs[k] = Ja[k].data();
     }
     if (!f.cost->Evaluate(f.blocks.data(), r.data(), jac_ptrs.data()))
       throw Error("marginalisation: a factor failed to evaluate");
-    std::vector<Eigen::MatrixXd> Jt(f.blocks.size());
     for (std::size_t k = 0; k < f.blocks.size(); ++k)
-      Jt[k] = tangentJacobian(Ja[k], f.blocks[k], sizes[k]);
+      tangentJacobian(Ja[k], f.blocks[k], sizes[k], &Jt[k]);
     if (f.loss) applyLoss(*f.loss, &r, &Jt);
     for (std::size_t a = 0; a < f.blocks.size(); ++a) {
       const int ia = offset[f.blocks[a]];
       g.segment(ia, Jt[a].cols()) += Jt[a].transpose() * r;
       for (std::size_t b = a; b < f.blocks.size(); ++b) {
         const int ib = offset[f.blocks[b]];
-        const Eigen::MatrixXd Hab = Jt[a].transpose() * Jt[b];
+        Hab.noalias() = Jt[a].transpose() * Jt[b];
         H.block(ia, ib, Hab.rows(), Hab.cols()) += Hab;
         if (a != b) H.block(ib, ia, Hab.cols(), Hab.rows()) += Hab.transpose();
       }
