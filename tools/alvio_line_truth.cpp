@@ -126,13 +126,10 @@ int main(int argc, char** argv) {
         if (!body) continue;  // no ground truth here: cannot score the frame
         const cv::Mat image = cv::imread(images[k].path, cv::IMREAD_GRAYSCALE);
         if (image.empty()) throw Error("cannot read image " + images[k].path);
-        Eigen::Isometry3d T_w_b = Eigen::Isometry3d::Identity();
-        T_w_b.linear() = body->q.toRotationMatrix();
-        T_w_b.translation() = body->p;
         const auto start = std::chrono::steady_clock::now();
         ProjectedEdges truth;
         for (const sim::VisibleEdge& v :
-             sim::projectVisibleEdges(scene.scene, *pinhole, T_w_b * config.camera.T_b_c))
+             sim::projectVisibleEdges(scene.scene, *pinhole, body->T_w_b() * config.camera.T_b_c))
           truth.push_back({v.edge_id, v.a_px, v.b_px});
         truth_ms +=
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)

@@ -34,13 +34,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-Eigen::Isometry3d cameraPose(const StampedPose& body, const Eigen::Isometry3d& T_b_c) {
-  Eigen::Isometry3d T_w_b = Eigen::Isometry3d::Identity();
-  T_w_b.linear() = body.q.toRotationMatrix();
-  T_w_b.translation() = body.p;
-  return T_w_b * T_b_c;
-}
-
 struct PointTruthOptions {
   bool oracle = false;
   double oracle_noise_px = 0;
@@ -85,7 +78,7 @@ class PointTruth {
 
 void PointTruth::process(const StampedPose& body, FeatureFrame* frame) {
   const bool filter = options_.oracle || options_.drop_px > 0;
-  const Eigen::Isometry3d T_w_c = cameraPose(body, T_b_c_);
+  const Eigen::Isometry3d T_w_c = body.T_w_b() * T_b_c_;
   const Eigen::Isometry3d T_c_w = T_w_c.inverse();
   const double fx = camera_.fx();
   std::vector<double> errs;

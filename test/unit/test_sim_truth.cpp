@@ -70,6 +70,9 @@ TEST(SimTruth, PoseInterpolation) {
   ASSERT_TRUE(mid);
   EXPECT_NEAR(mid->p.x(), 0.25, 1e-9);
   EXPECT_NEAR(Eigen::AngleAxisd(mid->q).angle(), 0.05, 1e-9);
+  const Eigen::Isometry3d T_w_b = mid->T_w_b();  // what the truth tools project with
+  EXPECT_NEAR((T_w_b * Vector3d::Zero() - mid->p).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((T_w_b.linear() * Vector3d::UnitX() - mid->q * Vector3d::UnitX()).norm(), 0.0, 1e-12);
   EXPECT_TRUE(interpolatePose(t, 1.01));
   EXPECT_FALSE(interpolatePose(t, 0.99));
   EXPECT_FALSE(interpolatePose(t, 1.02));

@@ -37,6 +37,12 @@ struct StampedPose {
   double t = 0.0;
   Eigen::Vector3d p = Eigen::Vector3d::Zero();
   Eigen::Quaterniond q = Eigen::Quaterniond::Identity();
+  Eigen::Isometry3d T_w_b() const {
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.linear() = q.toRotationMatrix();
+    T.translation() = p;
+    return T;
+  }
   EIGEN_MAKE_ALIGNED_OPERATOR_NEW
 };
 using Trajectory = std::vector<StampedPose, Eigen::aligned_allocator<StampedPose>>;
