@@ -1,6 +1,7 @@
 #include "test_support.h"
 
 #include <unistd.h>
+#include <algorithm>
 #include <cstdlib>
 
 #include <sys/wait.h>
@@ -21,6 +22,18 @@ std::string sharedDataDir() {
   if (const char* env = std::getenv("ALVIO_SHARED_DATA")) return fs::is_directory(env) ? env : "";
   const fs::path p = fs::path(ALVIO_SOURCE_DIR) / ".." / "shared" / "data";
   return fs::is_directory(p) ? fs::canonical(p).string() : "";
+}
+
+std::vector<std::string> sharedEurocImages() {
+  std::vector<std::string> files;
+  const std::string shared = sharedDataDir();
+  if (shared.empty()) return files;
+  const fs::path dir =
+      fs::path(shared) / "euroc_V1_01_easy_micro_kimera" / "mav0" / "cam0" / "data";
+  if (!fs::is_directory(dir)) return files;
+  for (const auto& e : fs::directory_iterator(dir)) files.push_back(e.path().string());
+  std::sort(files.begin(), files.end());
+  return files;
 }
 
 std::string scratchDir() {

@@ -7,11 +7,15 @@
 
 #include <functional>
 #include <string>
+#include <vector>
 
 namespace alvio::test {
 
 /// The shared data folder, or "" when it does not exist.
 std::string sharedDataDir();
+/// The real EuRoC camera images in the shared data (V1_01, cam0), sorted by name; empty when
+/// the shared data or that folder is missing.
+std::vector<std::string> sharedEurocImages();
 /// A scratch folder unique to the running test, emptied on its first use in the test.
 std::string scratchDir();
 /// Path of a file inside the source tree.

@@ -165,13 +165,8 @@ double lengthOf(const cv::Vec4f& s) {
 TEST(LinearTimeLsd, FindsOpenCvsSegmentsOnRealEuRoCFrames) {
   // The same algorithm and constants as OpenCV's LSD without refinement; only seeds of one
   // gradient bin may be tried in another order, so nearly every segment must be the same.
-  const std::string dir = test::sharedDataDir();
-  if (dir.empty()) GTEST_SKIP() << "../shared/data not found: no real EuRoC frames to compare on";
-  const std::filesystem::path images = dir + "/euroc_V1_01_easy_micro_kimera/mav0/cam0/data";
-  if (!std::filesystem::is_directory(images)) GTEST_SKIP() << images << " not found";
-  std::vector<std::filesystem::path> files;
-  for (const auto& e : std::filesystem::directory_iterator(images)) files.push_back(e.path());
-  std::sort(files.begin(), files.end());
+  const std::vector<std::string> files = test::sharedEurocImages();
+  if (files.empty()) GTEST_SKIP() << "../shared/data not found: no real EuRoC frames to compare on";
   ASSERT_GE(files.size(), 10u);
   const LineDetectorOptions o;  // the defaults: scale 0.5, sigma 0.6, quant 2
   const auto opencv = cv::createLineSegmentDetector(cv::LSD_REFINE_NONE, o.lsd_scale,
@@ -180,7 +175,7 @@ TEST(LinearTimeLsd, FindsOpenCvsSegmentsOnRealEuRoCFrames) {
   const double shortest = LineDetector(o, kSize).shortestLength();
   int theirs = 0, theirs_found = 0, ours = 0, ours_found = 0;
   for (std::size_t i = 0; i < files.size(); i += files.size() / 10) {
-    const cv::Mat image = cv::imread(files[i].string(), cv::IMREAD_GRAYSCALE);
+    const cv::Mat image = cv::imread(files[i], cv::IMREAD_GRAYSCALE);
     ASSERT_FALSE(image.empty()) << files[i];
     std::vector<cv::Vec4f> a, b;
     opencv->detect(image, a);
