@@ -6,7 +6,8 @@
 // tracked positions (same tracks, same IDs; lines as tracked, or none with --no-lines);
 // --drop-px keeps the tracked positions but drops those further than that from the truth.
 // --out writes trajectory.tum, point_errors.csv (per frame) and point_observations.csv (per
-// observation of a visible track point: age, pixel, error, frame-to-frame flow, depth).
+// observation of a visible track point: age, pixel, error, frame-to-frame flow, depth), and
+// the map files alvio_run writes (octomap.bt, lines.csv, ...), for alvio_map_truth.
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -22,10 +23,13 @@
 #include "alvio/common/error.h"
 #include "alvio/common/timing.h"
 #include "alvio/config/config.h"
+#include "alvio/config/yaml_reader.h"
 #include "alvio/eval/trajectory_evaluation.h"
 #include "alvio/eval/trajectory_interpolation.h"
 #include "alvio/io/euroc_dataset.h"
 #include "alvio/io/trajectory_io.h"
+#include "alvio/mapping/map_observer.h"
+#include "alvio/pipeline/offline_runner.h"
 #include "alvio/pipeline/vio_pipeline.h"
 #include "alvio/sim/sequence_scene.h"
 
@@ -157,7 +161,8 @@ int main(int argc, char** argv) {
                  "on the true projections of the same tracks.\n"
                  "Usage: alvio_point_truth [--config FILE] [options] SEQUENCE_DIR");
   args.option("config", "configuration (default: the installed config/euroc.yaml)", "");
-  args.option("out", "folder for trajectory.tum, point_errors.csv, point_observations.csv", "");
+  args.option(
+      "out", "folder for trajectory.tum, point_errors.csv, point_observations.csv and the map", "");
   args.option("frames", "frames to use (0: all)", "0");
   args.option("oracle-noise-px", "with --oracle: Gaussian noise added to the true positions", "0");
   args.option("drop-px", "drop tracked observations this far from the truth (0: keep all)", "0");
@@ -168,7 +173,9 @@ int main(int argc, char** argv) {
     const std::vector<std::string>& positional = args.positional();
     if (positional.size() != 1) throw Error("one SEQUENCE_DIR is required");
     const std::string seq = positional[0];
-    Config config = Config::load(args.isSet("config") ? args.get("config") : Config::defaultPath());
+    const YamlReader config_yaml(args.isSet("config") ? args.get("config") : Config::defaultPath());
+    Config config = Config::load(config_yaml);
+    const MappingOptions mapping = MappingOptions::load(config_yaml, "mapping");
     if (args.isSet("no-lines")) config.estimator.use_lines = false;
     const int max_frames = args.getInt("frames");
     const std::string out_dir = args.get("out");
@@ -183,6 +190,12 @@ int main(int argc, char** argv) {
         {args.isSet("oracle"), args.getDouble("oracle-noise-px"), args.getDouble("drop-px")},
         scene.scene, pipeline.camera(), config.camera.T_b_c, out_dir);
 
+    // The same map alvio_run builds, so that alvio_map_truth can score the oracle's map.
+    std::unique_ptr<MapObserver> map;
+    if (!out_dir.empty() && mapping.enabled) {
+      map = std::make_unique<MapObserver>(mapping, config.camera.T_b_c);
+      map->onStart({config, seq, out_dir, &gt});
+    }
     Trajectory estimate;
     std::size_t next_imu = 0;
     const auto& imu = data.imu();
@@ -198,6 +211,7 @@ int main(int argc, char** argv) {
       const PipelineOutput out = pipeline.addImage(gray, rec.t_ns, [&](FeatureFrame* frame) {
         if (const auto body = interpolatePose(gt, frame->t())) truth.process(*body, frame);
       });
+      if (map) map->onFrame({rec.t_ns, gray, out, pipeline});
       if (out.has_pose) {
         StampedPose p;
         p.t = out.state.t;
@@ -217,6 +231,7 @@ int main(int argc, char** argv) {
               << e.ate_translation_m.rmse << " m; point error median "
               << percentile(truth.errors(), 50) << " px over " << truth.errors().size()
               << " observations\n";
+    if (map) map->onFinish(RunResult());
     if (!out_dir.empty())
       writeTumTrajectory((fs::path(out_dir) / "trajectory.tum").string(), estimate);
     return 0;
