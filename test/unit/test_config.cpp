@@ -117,6 +117,17 @@ TEST(Config, SolverIterationsAreReadAndZeroForTheFirstSolveIsRejected) {
                         {"estimator.init_max_iterations", "must be at least 1"});
 }
 
+TEST(Config, PointDriftIsReadAndANegativeDriftIsRejected) {
+  const Config c = Config::load(test::sourcePath("config/euroc.yaml"));
+  EXPECT_DOUBLE_EQ(c.estimator.point_drift_px2_per_s, 0.0);
+  const std::string dir = test::scratchDir();
+  const std::string path = test::writeFile(
+      dir + "/drift.yaml",
+      eurocYamlReplacing("point_drift_px2_per_s: 0.0", "point_drift_px2_per_s: -1"));
+  expectErrorMentioning([&] { Config::load(path); },
+                        {"estimator.point_drift_px2_per_s", "must not be negative"});
+}
+
 TEST(Config, NonRotationExtrinsicIsRejected) {
   const std::string dir = test::scratchDir();
   const std::string path =

@@ -7,6 +7,7 @@
 #include "alvio/estimator/factors/imu_factor.h"
 #include "alvio/estimator/factors/marginalization.h"
 #include "alvio/estimator/factors/point_projection_factor.h"
+#include "alvio/estimator/point_noise.h"
 #include "alvio/estimator/pose_manifold.h"
 #include "factor_check.h"
 
@@ -79,6 +80,26 @@ TEST(PointProjectionFactor, ZeroResidualAtTruth) {
   inv_depth[0] *= 1.2;
   f.Evaluate(params, r, nullptr);
   EXPECT_GT(Eigen::Vector2d(r[0], r[1]).norm(), 1e-4);
+}
+
+TEST(PointNoise, WithoutDriftEverySightingHasTheWhiteNoiseExactly) {
+  // Bit for bit, so that drift 0 gives the trajectories of before the drift term.
+  for (double sigma : {1.5, 1.5 * (1 + 7e-4), 0.3})
+    for (double dt : {0.0, 0.05, 1.7, 12.0})
+      EXPECT_EQ(pointObservationSigmaPx(sigma, 0, dt), sigma);
+}
+
+TEST(PointNoise, VarianceGrowsLinearlyWithTheTimeSinceTheAnchor) {
+  const double s0 = 1.5, q = 1.0;
+  EXPECT_EQ(pointObservationSigmaPx(s0, q, 0), s0);
+  EXPECT_NEAR(pointObservationSigmaPx(s0, q, 1.5), std::sqrt(2.25 + 1.5), 1e-12);
+  const auto added = [&](double dt) {
+    return std::pow(pointObservationSigmaPx(s0, q, dt), 2) - s0 * s0;
+  };
+  EXPECT_NEAR(added(2.0), 2 * added(1.0), 1e-12);
+  EXPECT_NEAR(added(0.5), 0.5 * q, 1e-12);
+  // A sighting before the anchor's (not made by the estimator) is as far from it as one after.
+  EXPECT_EQ(pointObservationSigmaPx(s0, q, -0.7), pointObservationSigmaPx(s0, q, 0.7));
 }
 
 TEST(ImuFactor, AnalyticJacobiansMatchNumeric) {

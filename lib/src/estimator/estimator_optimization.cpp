@@ -15,6 +15,7 @@
 #include "alvio/estimator/factors/imu_factor.h"
 #include "alvio/estimator/factors/marginalization.h"
 #include "alvio/estimator/factors/point_projection_factor.h"
+#include "alvio/estimator/point_noise.h"
 #include "alvio/estimator/pose_manifold.h"
 #include "alvio/geometry/line_projection_factor.h"
 #include "alvio/geometry/line_quality.h"
@@ -115,8 +116,11 @@ double* Estimator::lineBlock(std::size_t k) {
 }
 
 PointProjectionFactor* Estimator::newPointFactor(const Eigen::Vector2d& obs_i,
-                                                 const Eigen::Vector2d& obs_j) const {
-  const double sqrt_info = point_scale_ * camera_.intrinsics[0] / options_.point_sigma_px;
+                                                 const Eigen::Vector2d& obs_j, int i, int j) const {
+  const double dt = 1e-9 * static_cast<double>(header_ns_[j] - header_ns_[i]);
+  const double sigma =
+      pointObservationSigmaPx(options_.point_sigma_px, options_.point_drift_px2_per_s, dt);
+  const double sqrt_info = point_scale_ * camera_.intrinsics[0] / sigma;
   return new PointProjectionFactor(obs_i, obs_j, T_b_c_, sqrt_info);
 }
 
@@ -212,8 +216,8 @@ void Estimator::optimize(FrameTiming* timing, int max_iterations) {
     if (l.sightings.size() > 1) ordering->AddElementToGroup(inverseDepthBlock(index), 0);
     for (std::size_t k = 1; k < l.sightings.size(); ++k) {
       const int j = i + static_cast<int>(k);
-      problem.AddResidualBlock(newPointFactor(obs_i, l.sightings[k].xy1.head<2>()), loss.get(),
-                               para_pose_[i].data(), para_pose_[j].data(),
+      problem.AddResidualBlock(newPointFactor(obs_i, l.sightings[k].xy1.head<2>(), i, j),
+                               loss.get(), para_pose_[i].data(), para_pose_[j].data(),
                                inverseDepthBlock(index));
     }
   }
@@ -311,7 +315,8 @@ void Estimator::marginalize() {
       const Eigen::Vector2d obs_i = l.sightings.front().xy1.head<2>();
       for (std::size_t k = 1; k < l.sightings.size(); ++k)
         info->addResidualBlock(
-            newPointFactor(obs_i, l.sightings[k].xy1.head<2>()), makeLoss(options_),
+            newPointFactor(obs_i, l.sightings[k].xy1.head<2>(), 0, static_cast<int>(k)),
+            makeLoss(options_),
             {para_pose_[0].data(), para_pose_[k].data(), inverseDepthBlock(index)}, {0, 2});
     }
     if (options_.use_lines) {

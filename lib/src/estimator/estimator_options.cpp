@@ -16,6 +16,7 @@ EstimatorOptions EstimatorOptions::load(const YamlReader& yaml, const std::strin
   o.init_max_iterations = yaml.getInt(p + "init_max_iterations", o.init_max_iterations);
   o.num_threads = yaml.getInt(p + "num_threads", o.num_threads);
   o.point_sigma_px = yaml.getDouble(p + "point_sigma_px", o.point_sigma_px);
+  o.point_drift_px2_per_s = yaml.getDouble(p + "point_drift_px2_per_s", o.point_drift_px2_per_s);
   o.robust_loss = yaml.getString(p + "robust_loss", o.robust_loss);
   o.robust_loss_scale = yaml.getDouble(p + "robust_loss_scale", o.robust_loss_scale);
   o.outlier_reprojection_px =
@@ -72,6 +73,8 @@ EstimatorOptions EstimatorOptions::load(const YamlReader& yaml, const std::strin
     throw Error(yaml.where(p + "init_settle_max_s") + " must not be negative");
   if (o.num_threads < 1) throw Error(yaml.where(p + "num_threads") + " must be at least 1");
   if (o.point_sigma_px <= 0) throw Error(yaml.where(p + "point_sigma_px") + " must be positive");
+  if (o.point_drift_px2_per_s < 0)
+    throw Error(yaml.where(p + "point_drift_px2_per_s") + " must not be negative (0: no drift)");
   if (o.line_sigma_px <= 0) throw Error(yaml.where(p + "line_sigma_px") + " must be positive");
   if (o.line_min_observations < 2)
     throw Error(yaml.where(p + "line_min_observations") + " must be at least 2");

@@ -221,7 +221,7 @@ class Estimator {
   double* lineBlock(std::size_t k);
   // Reprojection factors at the current weights, for the window solve and the prior alike.
   PointProjectionFactor* newPointFactor(const Eigen::Vector2d& obs_i,
-                                        const Eigen::Vector2d& obs_j) const;
+                                        const Eigen::Vector2d& obs_j, int i, int j) const;
   LineProjectionFactor* newLineFactor(const LineLandmarkObservation& obs) const;
   std::map<int64_t, int> windowSlots() const;  ///< frame stamp -> index in the window
 

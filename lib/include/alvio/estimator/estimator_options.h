@@ -18,6 +18,7 @@ struct EstimatorOptions {
   int init_max_iterations = 24;        ///< ...for the first solve after (re-)initialisation
   int num_threads = 1;                 ///< Ceres threads
   double point_sigma_px = 1.5;         ///< reprojection noise of points
+  double point_drift_px2_per_s = 0.0;  ///< tracking drift: variance (px^2) per second of age
   std::string robust_loss = "cauchy";  ///< cauchy | huber | none
   double robust_loss_scale = 1.0;      ///< in units of sigma
   double outlier_reprojection_px = 3.0;  ///< landmarks with a larger mean error are removed
