@@ -25,10 +25,7 @@ KeyframeLandmarks EstimatorKeyframeFeed::keyframe(const Estimator& estimator, in
   KeyframeLandmarks kf;
   const BodyState& s = window.at(index);
   kf.t = s.t;
-  Eigen::Isometry3d T_w_b = Eigen::Isometry3d::Identity();
-  T_w_b.linear() = s.q.toRotationMatrix();
-  T_w_b.translation() = s.p;
-  kf.T_w_c = T_w_b * T_b_c_;
+  kf.T_w_c = s.T_w_b() * T_b_c_;
   std::vector<Eigen::Vector3d> centres;
   for (const BodyState& b : window) centres.push_back(b.p + b.q * T_b_c_.translation());
   const auto& landmarks = estimator.points().landmarks();

@@ -46,6 +46,17 @@ OccupancyMap::OccupancyMap(const OccupancyMapOptions& options)
 namespace {
 constexpr double kMaxRayLength_m = 100.0;
 
+// Index of the highest set bit of v (> 0); the builtin where the compiler has one.
+int highestSetBit(uint64_t v) {
+#if defined(__GNUC__) || defined(__clang__)
+  return 63 - __builtin_clzll(v);
+#else
+  int i = 0;
+  while (v >>= 1) ++i;
+  return i;
+#endif
+}
+
 // Bit i of v moved to bit 3i.
 uint64_t spreadBits(uint16_t v) {
   uint64_t x = v;
@@ -123,7 +134,7 @@ void OccupancyMap::insert(const Eigen::Vector3d& origin_w,
       // The depths where this key takes the same child as the last one: those above its
       // highest differing 3-bit group.
       const uint64_t differ = u.code ^ last_code;
-      const int shared = differ ? 15 - (63 - __builtin_clzll(differ)) / 3 : 16;
+      const int shared = differ ? 15 - highestSetBit(differ) / 3 : 16;
       int d = std::min(valid, shared);
       octomap::OcTreeNode* node = path[d];
       for (; d < 16; ++d) {

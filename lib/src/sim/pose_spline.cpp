@@ -4,15 +4,13 @@
 #include <cmath>
 
 #include "alvio/common/error.h"
+#include "alvio/common/types.h"
 #include "alvio/sim/so3.h"
 
 namespace alvio::sim {
 
 Eigen::Isometry3d BodyState::T_w_b() const {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = q_w_b.toRotationMatrix();
-  T.translation() = p_w;
-  return T;
+  return isometry(p_w, q_w_b);
 }
 
 void cubicBSplineWeights(double u, double w[4], double dw[4], double ddw[4]) {

@@ -32,17 +32,20 @@ struct ImageRecord {
   std::string path;  ///< absolute or relative to the working directory
 };
 
+/// The rigid transform with rotation q and translation p.
+inline Eigen::Isometry3d isometry(const Eigen::Vector3d& p, const Eigen::Quaterniond& q) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = q.toRotationMatrix();
+  T.translation() = p;
+  return T;
+}
+
 /// A pose T_w_b at time t (seconds).
 struct StampedPose {
   double t = 0.0;
   Eigen::Vector3d p = Eigen::Vector3d::Zero();
   Eigen::Quaterniond q = Eigen::Quaterniond::Identity();
-  Eigen::Isometry3d T_w_b() const {
-    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-    T.linear() = q.toRotationMatrix();
-    T.translation() = p;
-    return T;
-  }
+  Eigen::Isometry3d T_w_b() const { return isometry(p, q); }
   EIGEN_MAKE_ALIGNED_OPERATOR_NEW
 };
 using Trajectory = std::vector<StampedPose, Eigen::aligned_allocator<StampedPose>>;

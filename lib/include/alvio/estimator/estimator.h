@@ -44,6 +44,8 @@ struct BodyState {
   Eigen::Vector3d v = Eigen::Vector3d::Zero();
   Eigen::Vector3d ba = Eigen::Vector3d::Zero();
   Eigen::Vector3d bg = Eigen::Vector3d::Zero();
+  /// The body pose in the world frame.
+  Eigen::Isometry3d T_w_b() const { return isometry(p, q); }
   EIGEN_MAKE_ALIGNED_OPERATOR_NEW
 };
 
@@ -219,9 +221,10 @@ class Estimator {
   std::size_t num_point_params_ = 0;
   double* inverseDepthBlock(int index) { return &para_landmarks_[index]; }
   double* lineBlock(std::size_t k);
-  // Reprojection factors at the current weights, for the window solve and the prior alike.
-  PointProjectionFactor* newPointFactor(const Eigen::Vector2d& obs_i,
-                                        const Eigen::Vector2d& obs_j, int i, int j) const;
+  // Reprojection factors at the current weights, for the window solve and the prior alike:
+  // sighting obs_j in window frame j against the anchor obs_i in frame i.
+  PointProjectionFactor* newPointFactor(const Eigen::Vector2d& obs_i, const Eigen::Vector2d& obs_j,
+                                        int i, int j) const;
   LineProjectionFactor* newLineFactor(const LineLandmarkObservation& obs) const;
   std::map<int64_t, int> windowSlots() const;  ///< frame stamp -> index in the window
 
