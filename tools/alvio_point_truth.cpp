@@ -173,7 +173,8 @@ int main(int argc, char** argv) {
     const std::vector<std::string>& positional = args.positional();
     if (positional.size() != 1) throw Error("one SEQUENCE_DIR is required");
     const std::string seq = positional[0];
-    const YamlReader config_yaml(args.isSet("config") ? args.get("config") : Config::defaultPath());
+    const YamlReader config_yaml =
+        Config::readYaml(args.isSet("config") ? args.get("config") : Config::defaultPath());
     Config config = Config::load(config_yaml);
     const MappingOptions mapping = MappingOptions::load(config_yaml, "mapping");
     if (args.isSet("no-lines")) config.estimator.use_lines = false;

@@ -208,6 +208,15 @@ TEST(ConfigBase, MissingBaseAndCyclesNameTheFile) {
   expectErrorMentioning([&] { Config::load(bad); }, {"bad.yaml", "'base' must name"});
 }
 
+TEST(ConfigBase, ReadYamlMergesTheBaseForOtherSections) {
+  // The tools that also read `mapping:` take the YAML from Config::readYaml: the section
+  // lives in the base file only.
+  const YamlReader yaml = Config::readYaml(test::sourcePath("config/euroc_real.yaml"));
+  EXPECT_TRUE(yaml.has("mapping.enabled"));
+  EXPECT_TRUE(yaml.has("camera.distortion_model"));
+  EXPECT_EQ(Config::load(yaml).camera.distortion_model, "radial-tangential");
+}
+
 TEST(ConfigBase, ShippedRealImuConfigIsEurocWithInFlightImuNoise) {
   const Config euroc = Config::load(test::sourcePath("config/euroc.yaml"));
   const Config real = Config::load(test::sourcePath("config/euroc_real.yaml"));

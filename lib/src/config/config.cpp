@@ -28,8 +28,12 @@ void checkSurfacesFitCamera(const Config& c, const YamlReader& yaml) {
 }
 }  // namespace
 
+YamlReader Config::readYaml(const std::string& path) {
+  return YamlReader::fromString(readConfigText(path), path);
+}
+
 Config Config::load(const std::string& path) {
-  return load(YamlReader::fromString(readConfigText(path), path));
+  return load(readYaml(path));
 }
 
 Config Config::load(const YamlReader& yaml) {

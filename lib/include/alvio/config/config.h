@@ -30,6 +30,9 @@ struct Config {
   /// The same from YAML already read (e.g. a file with ROS parameter overrides merged in);
   /// `source` becomes yaml.path().
   static Config load(const YamlReader& yaml);
+  /// The YAML of the file `path` with its `base:` files merged in, as load(path) reads it: for
+  /// callers that also read other sections (e.g. MappingOptions) from the same file.
+  static YamlReader readYaml(const std::string& path);
   /// The configuration shipped as config/euroc.yaml, found next to the sources or installed.
   static std::string defaultPath();
 };
