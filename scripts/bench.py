@@ -17,6 +17,12 @@ setting by 0.07 % has moved single-run ATE by up to 15 %. --repeats N runs each 
 k-th with --perturb's key (estimator.point_sigma_px) scaled by 1, 1 + s, 1 - s, 1 + 2s, ...
 (s = --perturb-step, 7e-4), and the tables give the mean ATE with its range and the median
 of the per-run times.
+
+A nudge samples little of a run's chaos; other noise seeds sample more (on sim_MH_05 seeds
+1, 2 and 3 gave 0.080, 0.080 and 0.098 m). --seeds 1,2,3 runs every sequence on each seed's
+rendering: seed 1 is --data's set, seed S the copy in DATA/seedS (alvio sim --benchmark
+DATA/seedS --seed S, which --render makes). The tables then give the mean over the seeds (and
+repeats) with its range, and --compare the ratio of each seed's pair.
 """
 import argparse
 import csv
@@ -73,8 +79,8 @@ def parse_variant(spec):
 
 
 class Run:
-    def __init__(self, seq, data, variant, args, out, binary, max_frames, repeat=0):
-        self.seq, self.variant, self.out, self.repeat = seq, variant, out, repeat
+    def __init__(self, seq, data, variant, args, out, binary, max_frames, repeat=0, seed=1):
+        self.seq, self.variant, self.out, self.repeat, self.seed = seq, variant, out, repeat, seed
         argv = [x.replace("{out}", str(out)) for x in args]  # "{out}": this run's folder
         if "--bin" in argv:
             i = argv.index("--bin")
@@ -107,7 +113,8 @@ class Run:
         self.log.close()
 
     def result(self):
-        r = {"sequence": self.seq, "variant": self.variant, "repeat": self.repeat, "rc": self.rc,
+        r = {"sequence": self.seq, "variant": self.variant, "repeat": self.repeat,
+             "seed": self.seed, "rc": self.rc,
              "wall_s": self.wall_s, "cpu_s": self.cpu_s, "peak_rss_mb": self.rss_mb}
         summary = self.out / "summary.json"
         if summary.exists():
@@ -238,7 +245,7 @@ def aggregate(results):
         a["ate_min"], a["ate_max"] = (min(ates), max(ates)) if ates else (None, None)
         a["resets"] = max((r.get("resets") or 0) for r in runs)
         for k, v in runs[0].items():
-            if k in ("ate", "resets", "repeat", "rc") or not isinstance(v, (int, float)):
+            if k in ("ate", "resets", "repeat", "seed", "rc") or not isinstance(v, (int, float)):
                 continue
             vals = [r[k] for r in runs if isinstance(r.get(k), (int, float))]
             a[k] = statistics.median(vals) if len(vals) == len(runs) else None
@@ -271,7 +278,8 @@ def run_all(runs, jobs):
         done += 1
         res = r.result()
         ate = f"ATE {res['ate']:.4f} m" if res.get("ate") is not None else f"exit {r.rc}"
-        log(f"[{done}/{len(runs)}] {r.seq} {r.variant}: {ate}, {r.wall_s:.0f} s "
+        seed = f" seed {r.seed}" if r.seed != 1 else ""
+        log(f"[{done}/{len(runs)}] {r.seq}{seed} {r.variant}: {ate}, {r.wall_s:.0f} s "
             f"(see {r.out}/run.log)")
 
 
@@ -316,16 +324,33 @@ def ratio(a, b):
     return None if a is None or b is None or a == 0 else b / a
 
 
-def compare_table(results, a, b):
-    lines = [f"| sequence | ATE {a} | ATE {b} | ATE ratio | total median ratio | opt+marg ratio "
-             f"| peak RSS ratio |", "|---|---|---|---|---|---|---|"]
+def paired_ratios(per_run, seq, a, b):
+    """B/A ATE ratios of the runs that share sequence, seed and repeat, in seed order."""
+    ates = {(r["variant"], r.get("seed", 1), r.get("repeat", 0)): r.get("ate")
+            for r in per_run if r["sequence"] == seq}
+    return [ratio(ates[(a, s, k)], ates[(b, s, k)])
+            for (v, s, k) in sorted(ates, key=lambda key: (key[1], key[2]))
+            if v == a and (b, s, k) in ates]
+
+
+def compare_table(results, a, b, per_run=None):
+    """Ratios B/A. With per_run from several seeds, also each seed's ATE ratio."""
+    seeds = sorted({r.get("seed", 1) for r in per_run or []})
+    each = len(seeds) > 1
+    lines = [f"| sequence | ATE {a} | ATE {b} | ATE ratio |"
+             + (" ATE ratio per run (seeds " + ", ".join(map(str, seeds)) + ") |" if each else "")
+             + " total median ratio | opt+marg ratio | peak RSS ratio |",
+             "|---|---|---|---|" + ("---|" if each else "") + "---|---|---|"]
     by = {(r["sequence"], r["variant"]): r for r in results}
     for seq in dict.fromkeys(r["sequence"] for r in results):
         ra, rb = by.get((seq, a), {}), by.get((seq, b), {})
+        per_seed = ""
+        if each:
+            per_seed = " / ".join(fmt(x, ".3f") for x in paired_ratios(per_run, seq, a, b)) + " | "
         lines.append(
             f"| {seq} | {ate_cell(ra)} | {ate_cell(rb)} "
-            f"| {fmt(ratio(ra.get('ate'), rb.get('ate')), '.3f')} "
-            f"| {fmt(ratio(stage(ra, 'total'), stage(rb, 'total')), '.3f')} "
+            f"| {fmt(ratio(ra.get('ate'), rb.get('ate')), '.3f')} | {per_seed}"
+            f"{fmt(ratio(stage(ra, 'total'), stage(rb, 'total')), '.3f')} "
             f"| {fmt(ratio(ra.get('opt_total_median'), rb.get('opt_total_median')), '.3f')} "
             f"| {fmt(ratio(ra.get('peak_rss_mb'), rb.get('peak_rss_mb')), '.3f')} |")
     return "\n".join(lines)
@@ -369,6 +394,9 @@ def main():
                     help="the configuration key --repeats scales [%(default)s]")
     ap.add_argument("--perturb-step", type=float, default=7e-4,
                     help="relative step of that scaling [%(default)s]")
+    ap.add_argument("--seeds", default="1",
+                    help="comma-separated noise seeds; seed S > 1 runs DATA/seedS's copy of each "
+                    "sequence [%(default)s]")
     ap.add_argument("--bin", default=os.environ.get("ALVIO_RUN", str(ROOT / "build/devel/lib/alvio/alvio_run")))
     ap.add_argument("--freeze", action="store_true",
                     help="copy the build's programs and libraries into OUT/bin first, so a rebuild "
@@ -377,6 +405,12 @@ def main():
     a = ap.parse_args()
     if a.repeats < 1:
         sys.exit("alvio bench: error: --repeats must be at least 1")
+    try:
+        seeds = [int(x) for x in a.seeds.split(",")]
+    except ValueError:
+        seeds = []
+    if not seeds or min(seeds) < 1 or len(set(seeds)) != len(seeds):
+        sys.exit(f"alvio bench: error: --seeds '{a.seeds}' is not a list of distinct seeds >= 1")
 
     if a.ablation:
         variants = [v for _, v in ABLATION]
@@ -388,17 +422,28 @@ def main():
     seqs = (a.sequences.split(",") if a.sequences else
             (["sim_MH_05"] if a.ablation else DEFAULT_SEQUENCES))
     data = Path(a.data)
+
+    def seed_set(seed):
+        return data if seed == 1 else data / f"seed{seed}"
+
+    if seeds != [1]:
+        given = [s for s in seqs if Path(s).is_dir()]
+        if given:
+            sys.exit(f"alvio bench: error: --seeds needs sequence names, not folders ({given[0]})")
     if a.render:
         names = [s for s in seqs if not Path(s).is_dir()]
         sim = Path(a.bin).with_name("alvio_sim")
-        subprocess.run([str(sim), "--benchmark", str(data), "--only", ",".join(names)], check=True)
-    datasets = []
+        for seed in seeds:
+            subprocess.run([str(sim), "--benchmark", str(seed_set(seed)), "--seed", str(seed),
+                            "--only", ",".join(names)], check=True)
+    datasets = []  # (name, folder, seed)
     for s in seqs:
-        d = Path(s) if Path(s).is_dir() else data / s
-        if not (d / "mav0").is_dir():
-            sys.exit(f"alvio bench: no sequence {d} (render it: ./alvio sim --benchmark {data} "
-                     f"--only {s}, or pass --render)")
-        datasets.append((d.name, d))
+        for seed in seeds:
+            d = Path(s) if Path(s).is_dir() else seed_set(seed) / s
+            if not (d / "mav0").is_dir():
+                sys.exit(f"alvio bench: no sequence {d} (render it: ./alvio sim --benchmark "
+                         f"{seed_set(seed)} --seed {seed} --only {s}, or pass --render)")
+            datasets.append((d.name, d, seed))
     if any(v in ("sel-lines", "sel-points", "sel-both") for v in variants) and not SURFACES.exists():
         sys.exit(f"alvio bench: {SURFACES} is missing (make it with ./alvio analyze)")
 
@@ -428,14 +473,18 @@ def main():
         return args + ["--config", str(config_dir / ("euroc_real.yaml" if is_real_imu(name)
                                                      else "euroc.yaml"))]
 
-    def folder(name, v, k):
-        return out / name / v if a.repeats == 1 else out / name / v / f"r{k}"
+    def folder(name, v, k, seed):
+        f = out / name / v
+        if len(seeds) > 1:
+            f = f / f"s{seed}"
+        return f if a.repeats == 1 else f / f"r{k}"
 
-    # Interleave variants per sequence (and repeat) so that load drifts hit all of them alike.
+    # Interleave variants per sequence (seed and repeat) so that load drifts hit all alike.
     runs = [Run(name, d, v, perturbed_args(with_config(name, args), a.perturb, a.perturb_step, k),
-                folder(name, v, k), a.bin, a.max_frames, k)
-            for name, d in datasets for k in range(a.repeats) for v, args in parsed]
-    log(f"{len(runs)} runs ({len(datasets)} sequences x {len(parsed)} variants"
+                folder(name, v, k, seed), a.bin, a.max_frames, k, seed)
+            for name, d, seed in datasets for k in range(a.repeats) for v, args in parsed]
+    log(f"{len(runs)} runs ({len(seqs)} sequences"
+        f"{f' x {len(seeds)} seeds' if len(seeds) > 1 else ''} x {len(parsed)} variants"
         f"{f' x {a.repeats} repeats' if a.repeats > 1 else ''}), {a.jobs} at a time, into {out}")
     run_all(runs, a.jobs)
     per_run = [r.result() for r in runs]
@@ -443,15 +492,20 @@ def main():
     results = aggregate(per_run)
 
     if a.ablation:
-        text = "\n\n".join(ablation_table(results, name) for name, _ in datasets)
+        text = "\n\n".join(ablation_table(results, name) for name in dict.fromkeys(
+            name for name, _, _ in datasets))
     else:
         text = bench_table(results)
         if a.compare:
-            text += "\n\n" + compare_table(results, parsed[0][0], parsed[1][0])
-    if a.repeats > 1:
+            text += "\n\n" + compare_table(results, parsed[0][0], parsed[1][0], per_run)
+    if len(seeds) > 1:
+        text += (f"\n\nEach row: the runs on noise seeds {a.seeds} (seed S > 1: {data}/seedS)"
+                 f"{f', {a.repeats} each' if a.repeats > 1 else ''}; ATE is their mean (range), "
+                 "times and memory their median.")
+    elif a.repeats > 1:
         text += (f"\n\nEach row: {a.repeats} runs with {a.perturb} scaled by 1, 1 ± {a.perturb_step:g}, "
                  "...; ATE is their mean (range), times and memory their median.")
-    if any(is_real_imu(name) for name, _ in datasets):
+    if any(is_real_imu(name) for name, _, _ in datasets):
         text += ("\n\nSequences with the real EuRoC IMU (`*_realimu`) run with "
                  "config/euroc_real.yaml (in-flight IMU noise), the others with config/euroc.yaml.")
     (out / "results.md").write_text(text + "\n")

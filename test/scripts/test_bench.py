@@ -237,6 +237,12 @@ for a in [argv[i + 1] for i, x in enumerate(argv) if x == "--set"]:
             summary = json.loads((out / "summary.json").read_text())
             summary["ate_rmse_m"] *= float(kv.split("=")[1]) / 1.5
             (out / "summary.json").write_text(json.dumps(summary))
+# Another noise seed's rendering (DATA/seedS/<sequence>) gives another result: ATE x S.
+seed_set = Path(argv[argv.index("--dataset") + 1]).parent.name
+if seed_set.startswith("seed"):
+    summary = json.loads((out / "summary.json").read_text())
+    summary["ate_rmse_m"] *= int(seed_set[4:])
+    (out / "summary.json").write_text(json.dumps(summary))
 sys.exit(int((src / "rc").read_text()) if (src / "rc").exists() else 0)
 """
 
@@ -426,6 +432,51 @@ class MainTest(unittest.TestCase):
             ates = [base * s / 1.5 for s in sigma]
             self.assertEqual(row[2], f"{np.mean(ates):.4f} ({min(ates):.4f}–{max(ates):.4f})")
         self.assertIn("3 runs with estimator.point_sigma_px scaled", p.stdout)
+
+    def test_seeds_run_each_seeds_rendering_and_pair_the_ratios(self):
+        for seed in (2, 5):
+            for seq in ("sim_A", "sim_B_realimu"):
+                (self.data / f"seed{seed}" / seq / "mav0").mkdir(parents=True)
+        p = self.bench("--sequences", "sim_A,sim_B_realimu", "--compare", "points", "lines",
+                       "--seeds", "1,2,5")
+        self.assertEqual(p.returncode, 0, p.stderr)
+        out = self.dir / "out"
+        results = json.loads((out / "results.json").read_text())
+        # Interleaved per sequence and seed; each run on its seed's copy, in a folder of its own.
+        self.assertEqual([(r["sequence"], r["seed"], r["variant"]) for r in results],
+                         [(q, s, v) for q in ("sim_A", "sim_B_realimu") for s in (1, 2, 5)
+                          for v in ("points", "lines")])
+        for r in results:
+            folder = out / r["sequence"] / r["variant"] / f"s{r['seed']}"
+            argv = json.loads((folder / "argv.json").read_text())
+            data = self.data if r["seed"] == 1 else self.data / f"seed{r['seed']}"
+            self.assertEqual(argv[argv.index("--dataset") + 1], str(data / r["sequence"]))
+        tables = p.stdout.split("\n\n")
+        rows = table_rows(tables[0])
+        self.assertEqual([row[:2] for row in rows],
+                         [[q, v] for q in ("sim_A", "sim_B_realimu") for v in ("points", "lines")])
+        for row in rows:
+            base = self.inputs[row[0], row[1]]["summary"]["ate_rmse_m"]
+            ates = [base * s for s in (1, 2, 5)]
+            self.assertEqual(row[2], f"{np.mean(ates):.4f} ({min(ates):.4f}–{max(ates):.4f})")
+        compare = table_rows(tables[1])
+        self.assertIn("ATE ratio per run (seeds 1, 2, 5)", tables[1])
+        for row in compare:
+            r = (self.inputs[row[0], "lines"]["summary"]["ate_rmse_m"] /
+                 self.inputs[row[0], "points"]["summary"]["ate_rmse_m"])
+            self.assertEqual(row[3], f"{r:.3f}")  # the ratio of the means
+            self.assertEqual(row[4], " / ".join([f"{r:.3f}"] * 3))
+        self.assertIn("noise seeds 1,2,5", p.stdout)
+
+    def test_seed_without_its_rendering_names_the_folder(self):
+        p = self.bench("--sequences", "sim_A", "--seeds", "1,3")
+        self.assertNotEqual(p.returncode, 0)
+        self.assertIn(str(self.data / "seed3" / "sim_A"), p.stderr)
+        self.assertIn("--seed 3", p.stderr)
+        for bad in ("0,1", "1,1", "x"):
+            p = self.bench("--sequences", "sim_A", "--seeds", bad)
+            self.assertNotEqual(p.returncode, 0)
+            self.assertIn("--seeds", p.stderr)
 
     def test_missing_sequence_names_it(self):
         p = self.bench("--sequences", "sim_nowhere")
