@@ -475,7 +475,7 @@ def main():
 
     def folder(name, v, k, seed):
         f = out / name / v
-        if len(seeds) > 1:
+        if seeds != [1]:  # a run on another seed's rendering says so in its folder
             f = f / f"s{seed}"
         return f if a.repeats == 1 else f / f"r{k}"
 
@@ -498,7 +498,7 @@ def main():
         text = bench_table(results)
         if a.compare:
             text += "\n\n" + compare_table(results, parsed[0][0], parsed[1][0], per_run)
-    if len(seeds) > 1:
+    if seeds != [1]:
         text += (f"\n\nEach row: the runs on noise seeds {a.seeds} (seed S > 1: {data}/seedS)"
                  f"{f', {a.repeats} each' if a.repeats > 1 else ''}; ATE is their mean (range), "
                  "times and memory their median.")

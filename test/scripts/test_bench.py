@@ -468,6 +468,13 @@ class MainTest(unittest.TestCase):
             self.assertEqual(row[4], " / ".join([f"{r:.3f}"] * 3))
         self.assertIn("noise seeds 1,2,5", p.stdout)
 
+    def test_one_other_seed_is_labelled_too(self):
+        (self.data / "seed2" / "sim_A" / "mav0").mkdir(parents=True)
+        p = self.bench("--sequences", "sim_A", "--variants", "lines", "--seeds", "2")
+        self.assertEqual(p.returncode, 0, p.stderr)
+        self.assertTrue((self.dir / "out" / "sim_A" / "lines" / "s2" / "summary.json").exists())
+        self.assertIn("noise seeds 2", p.stdout)
+
     def test_seed_without_its_rendering_names_the_folder(self):
         p = self.bench("--sequences", "sim_A", "--seeds", "1,3")
         self.assertNotEqual(p.returncode, 0)
