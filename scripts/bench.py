@@ -450,8 +450,11 @@ def main():
     out = Path(a.out)
     if a.freeze:
         env = dict(os.environ, ALVIO_BUILD_DIR=str(Path(a.bin).resolve().parents[3]))
-        a.bin = subprocess.run([str(ROOT / "scripts/freeze_build.sh"), str(out / "frozen")], env=env,
-                               check=True, capture_output=True, text=True).stdout.strip()
+        frozen = subprocess.run([str(ROOT / "scripts/freeze_build.sh"), str(out / "frozen")],
+                                env=env, capture_output=True, text=True)
+        if frozen.returncode != 0:
+            sys.exit(f"alvio bench: --freeze failed: {frozen.stderr.strip()}")
+        a.bin = frozen.stdout.strip()
         # The configuration too: a run reads it when it starts, and an edit during a long
         # benchmark would otherwise split the runs between two settings.
         frozen_config = out / "frozen" / "config"

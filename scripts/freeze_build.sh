@@ -9,7 +9,31 @@ set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BUILD="${ALVIO_BUILD_DIR:-$ROOT/build}"
 out="${1:?usage: freeze_build.sh OUT_DIR}"
+[[ -d "$BUILD/devel/lib" ]] || { echo "freeze_build.sh: no build in $BUILD (run ./alvio build)" >&2; exit 1; }
+
+# A copy taken while make is relinking mixes old and new programs and libraries (a run that
+# ignored --no-lines, then a crash), so refuse while a compiler or linker works in BUILD.
+refuse_during_build() {
+  local build_real cwd comm p
+  build_real="$(cd "$BUILD" && pwd -P)"
+  for p in /proc/[0-9]*; do
+    cwd="$(readlink "$p/cwd" 2>/dev/null)" || continue
+    case "$cwd/" in "$build_real"/*) ;; *) continue ;; esac
+    comm="$(cat "$p/comm" 2>/dev/null)" || continue
+    case "$comm" in
+      make | gmake | ninja | cmake | cc1 | cc1plus | c++ | g++ | gcc | clang* | ld | ld.* | collect2 | ar | ranlib)
+        echo "freeze_build.sh: a build is running in $BUILD (pid ${p#/proc/}, $comm);" \
+          "wait for it to finish, then freeze again" >&2
+        exit 1
+        ;;
+    esac
+  done
+}
+
+refuse_during_build
 mkdir -p "$out/lib" "$out/bin"
 cp -a "$BUILD"/devel/lib/*.so* "$out/lib/"
 cp -a "$BUILD"/devel/lib/alvio/alvio_run "$BUILD"/devel/lib/alvio/alvio_sim "$out/bin/"
+# A build that started during the copy may have replaced some of the files already copied.
+refuse_during_build
 echo "$out/bin/alvio_run"
