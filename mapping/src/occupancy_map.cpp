@@ -107,8 +107,9 @@ void OccupancyMap::insert(const Eigen::Vector3d& origin_w,
     if (p.allFinite() && (p - origin_w).norm() < kMaxRayLength_m)
       cloud.push_back(p.x(), p.y(), p.z());
   // As OcTree::insertPointCloud with lazy evaluation and discretisation (one ray per end voxel,
-  // which matters for densely sampled lines), but an existing leaf is updated where it is
-  // found: updateNode searches for it and then descends to it a second time. The voxels are
+  // which matters for densely sampled lines), but each voxel is updated, or its path created,
+  // where the descent reaches it: updateNode searches the tree from the root and then descends
+  // it a second time. The voxels are
   // visited in the tree's depth-first order, each descent starting where the last one's path
   // parts from it: neighbouring voxels share most of their path. Same map: the sets are
   // disjoint and each voxel's update depends on that voxel alone.
@@ -142,6 +143,15 @@ void OccupancyMap::insert(const Eigen::Vector3d& origin_w,
         if (!tree_->nodeChildExists(node, child)) break;
         node = tree_->getNodeChild(node, child);
         path[d + 1] = node;
+      }
+      // A new voxel (about 40 % of them) under a node with other children: its path is
+      // created from there, as updateNode would after searching the tree from the root. A
+      // node without children above full depth is a pruned leaf, which updateNode expands.
+      if (d < 16 && tree_->nodeHasChildren(node)) {
+        for (; d < 16; ++d) {
+          node = tree_->createNodeChild(node, (u.code >> (3 * (15 - d))) & 7u);
+          path[d + 1] = node;
+        }
       }
       valid = d;
       if (d == 16) leaf = node;
