@@ -93,7 +93,7 @@ class OccupancyMap {
   OccupancyMapOptions options_;
   std::unique_ptr<octomap::OcTree> tree_;
   mutable bool inner_nodes_stale_ = false;
-  std::vector<VoxelUpdate> updates_;  // one insertion's voxels, kept for its capacity
+  std::vector<VoxelUpdate> updates_, scratch_;  // one insertion's voxels, kept for capacity
 };
 
 }  // namespace alvio
