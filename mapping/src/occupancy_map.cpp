@@ -122,28 +122,51 @@ void OccupancyMap::insert(const Eigen::Vector3d& origin_w,
     inner_nodes_stale_ = true;
     return;
   }
-  octomap::Pointcloud cloud;
-  cloud.reserve(points_w.size());
-  // Even with an unlimited range, a diverged landmark kilometres away would make the ray
-  // caster allocate millions of keys: such points are never inserted.
-  for (const Eigen::Vector3d& p : points_w)
-    if (p.allFinite() && (p - origin_w).norm() < kMaxRayLength_m)
-      cloud.push_back(p.x(), p.y(), p.z());
   // As OcTree::insertPointCloud with lazy evaluation and discretisation (one ray per end voxel,
-  // which matters for densely sampled lines), but each voxel is updated, or its path created,
-  // where the descent reaches it: updateNode searches the tree from the root and then descends
-  // it a second time. The voxels are
-  // visited in the tree's depth-first order, each descent starting where the last one's path
-  // parts from it: neighbouring voxels share most of their path. Same map: the sets are
-  // disjoint and each voxel's update depends on that voxel alone.
-  octomap::KeySet free_cells, occupied_cells;
-  tree_->computeDiscreteUpdate(cloud, origin, free_cells, occupied_cells, options_.max_range);
+  // to its centre, which matters for densely sampled lines), with the same voxels, but:
+  // - the ray keys are gathered in one vector, sorted and merged (a voxel both free and
+  //   occupied is occupied, as in OctoMap) instead of going through two hash sets;
+  // - each voxel is updated, or its path created, where the descent reaches it: updateNode
+  //   searches the tree from the root and then descends it a second time. The voxels are
+  //   visited in the tree's depth-first order, each descent starting where the last one's
+  //   path parts from it: neighbouring voxels share most of their path.
+  // Same map: each voxel's update depends on that voxel alone.
   updates_.clear();
-  updates_.reserve(free_cells.size() + occupied_cells.size());
-  for (const octomap::OcTreeKey& key : free_cells) updates_.push_back({pathCode(key), key, false});
-  for (const octomap::OcTreeKey& key : occupied_cells)
+  for (const Eigen::Vector3d& p : points_w) {
+    // Even with an unlimited range, a diverged landmark kilometres away would make the ray
+    // caster allocate millions of keys: such points are never inserted.
+    if (!p.allFinite() || (p - origin_w).norm() >= kMaxRayLength_m) continue;
+    const octomap::OcTreeKey key = tree_->coordToKey(octomap::point3d(p.x(), p.y(), p.z()));
     updates_.push_back({pathCode(key), key, true});
+  }
   sortByCode(&updates_, &scratch_);
+  end_keys_.clear();
+  for (std::size_t i = 0; i < updates_.size(); ++i)
+    if (i == 0 || updates_[i].code != updates_[i - 1].code) end_keys_.push_back(updates_[i].key);
+  updates_.clear();
+  auto addRay = [&](const octomap::point3d& end) {
+    if (!tree_->computeRayKeys(origin, end, ray_)) return;
+    for (const octomap::OcTreeKey& key : ray_) updates_.push_back({pathCode(key), key, false});
+  };
+  for (const octomap::OcTreeKey& end_key : end_keys_) {
+    const octomap::point3d end = tree_->keyToCoord(end_key);
+    if (options_.max_range < 0.0 || (end - origin).norm() <= options_.max_range) {
+      addRay(end);
+      octomap::OcTreeKey key;
+      if (tree_->coordToKeyChecked(end, key)) updates_.push_back({pathCode(key), key, true});
+    } else {
+      addRay(origin + (end - origin).normalized() * static_cast<float>(options_.max_range));
+    }
+  }
+  sortByCode(&updates_, &scratch_);
+  std::size_t merged = 0;
+  for (std::size_t i = 0; i < updates_.size(); ++i) {
+    if (merged > 0 && updates_[merged - 1].code == updates_[i].code)
+      updates_[merged - 1].occupied |= updates_[i].occupied;
+    else
+      updates_[merged++] = updates_[i];
+  }
+  updates_.resize(merged);
   const int depth = static_cast<int>(tree_->getTreeDepth());
   const bool in_place = !tree_->isChangeDetectionEnabled() && depth == 16;
   // path[d]: the node at depth d on the last key's path, valid for d <= valid.

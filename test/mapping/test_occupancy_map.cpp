@@ -173,3 +173,33 @@ TEST(OccupancyMap, InPlaceUpdatesGiveOctomapsOwnLogOdds) {
   EXPECT_EQ(ours.str(), theirs.str());
   EXPECT_GT(map.counts().occupied, 50u);
 }
+
+TEST(OccupancyMap, CutRaysGiveOctomapsOwnTree) {
+  // With a range limit, points beyond it only carve free space up to the range: against
+  // octomap's own insertPointCloud, log-odds and all.
+  OccupancyMapOptions options;
+  options.max_range = 2.5;
+  OccupancyMap map(options);
+  octomap::OcTree reference(map.options().resolution);
+  setSensorModelOf(map, &reference);
+  std::mt19937 rng(23);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int k = 0; k < 15; ++k) {
+    const Vector3d origin(0.1 * k, 0.3 * u(rng), 0.2 * u(rng));
+    std::vector<Vector3d> points;
+    for (int i = 0; i < 120; ++i)
+      // A wall at 2 m (within range) and one at 4 m (beyond it), with repeats in one voxel.
+      points.push_back(i % 3 == 0   ? Vector3d(0.1 * k + 2.0, u(rng), 0.5 * u(rng))
+                       : i % 3 == 1 ? Vector3d(0.1 * k + 4.0, 2 * u(rng), u(rng))
+                                    : Vector3d(0.1 * k + 2.0, 0.01, 0.01));
+    insertIntoBoth(origin, points, &map, &reference, /*tree_lazy_eval=*/true);
+  }
+  reference.updateInnerOccupancy();
+  reference.prune();
+  std::ostringstream ours, theirs;
+  map.tree().write(ours);
+  reference.write(theirs);
+  EXPECT_EQ(ours.str(), theirs.str());
+  EXPECT_GT(map.counts().occupied, 20u);
+  EXPECT_FALSE(map.isOccupied(Vector3d(4.05, 0.0, 0.0)));  // beyond the range: never occupied
+}

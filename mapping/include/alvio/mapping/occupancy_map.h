@@ -93,7 +93,10 @@ class OccupancyMap {
   OccupancyMapOptions options_;
   std::unique_ptr<octomap::OcTree> tree_;
   mutable bool inner_nodes_stale_ = false;
-  std::vector<VoxelUpdate> updates_, scratch_;  // one insertion's voxels, kept for capacity
+  // One insertion's work, kept for its capacity (a KeyRay allocates room for 100000 keys).
+  std::vector<VoxelUpdate> updates_, scratch_;
+  std::vector<octomap::OcTreeKey> end_keys_;
+  octomap::KeyRay ray_;
 };
 
 }  // namespace alvio
