@@ -7,31 +7,8 @@
 #include <unordered_map>
 
 #include "alvio/common/error.h"
-#include "alvio/config/yaml_reader.h"
 
 namespace alvio {
-
-PointTrackerOptions PointTrackerOptions::load(const YamlReader& yaml, const std::string& prefix) {
-  PointTrackerOptions o;
-  const std::string p = prefix + ".";
-  o.max_features = yaml.getInt(p + "max_features", o.max_features);
-  o.min_distance_px = yaml.getInt(p + "min_distance_px", o.min_distance_px);
-  o.quality_level = yaml.getDouble(p + "quality_level", o.quality_level);
-  o.ransac_threshold_px = yaml.getDouble(p + "ransac_threshold_px", o.ransac_threshold_px);
-  o.equalize = yaml.getBool(p + "equalize", o.equalize);
-  o.exposure_jump = yaml.getDouble(p + "exposure_jump", o.exposure_jump);
-  o.klt_window = yaml.getInt(p + "klt_window", o.klt_window);
-  o.klt_levels = yaml.getInt(p + "klt_levels", o.klt_levels);
-  o.forward_backward_check = yaml.getBool(p + "forward_backward_check", o.forward_backward_check);
-  o.forward_backward_max_px =
-      yaml.getDouble(p + "forward_backward_max_px", o.forward_backward_max_px);
-  if (o.exposure_jump < 0) throw Error(yaml.where(p + "exposure_jump") + " must not be negative");
-  if (o.max_features < 8) throw Error(yaml.where(p + "max_features") + " must be at least 8");
-  if (o.min_distance_px < 1) throw Error(yaml.where(p + "min_distance_px") + " must be at least 1");
-  if (o.klt_window < 5 || o.klt_window % 2 == 0)
-    throw Error(yaml.where(p + "klt_window") + " must be an odd number >= 5");
-  return o;
-}
 
 PointTracker::PointTracker(const PointTrackerOptions& options,
                            std::shared_ptr<const CameraModel> camera)

@@ -7,7 +7,7 @@
 #include "alvio/config/logger_options.h"
 #include "alvio/config/sensor_options.h"
 #include "alvio/estimator/estimator_options.h"
-#include "alvio/frontend/point_tracker.h"
+#include "alvio/frontend/point_tracker_options.h"
 #include "alvio/lines/line_tracker_options.h"
 
 namespace alvio {

@@ -13,27 +13,9 @@
 #include "alvio/common/timing.h"
 #include "alvio/frontend/corner_detector.h"
 #include "alvio/frontend/feature_frame.h"
+#include "alvio/frontend/point_tracker_options.h"
 
 namespace alvio {
-
-class YamlReader;
-
-struct PointTrackerOptions {
-  int max_features = 150;            ///< target number of tracked corners
-  int min_distance_px = 30;          ///< minimum distance between corners
-  double quality_level = 0.01;       ///< Shi-Tomasi quality relative to the best corner
-  double ransac_threshold_px = 1.0;  ///< fundamental-matrix RANSAC threshold
-  bool equalize = true;              ///< CLAHE before tracking (robust to exposure changes)
-  /// A frame whose mean brightness jumps by more than this fraction is scaled back to the
-  /// previous level before point and line tracking (0: off). See exposure_compensation.h.
-  double exposure_jump = 0.15;
-  int klt_window = 21;
-  int klt_levels = 3;
-  bool forward_backward_check = true;  ///< track back and reject points that do not return
-  double forward_backward_max_px = 0.5;
-
-  static PointTrackerOptions load(const YamlReader& yaml, const std::string& prefix);
-};
 
 class PointTracker {
  public:
