@@ -78,6 +78,16 @@ def parse_variant(spec):
     return name, shlex.split(args)
 
 
+def program_env(program):
+    """The environment to start one of alvio's programs in: a frozen build's
+    (scripts/freeze_build.sh: OUT/bin/<program>) needs its own libraries, not build/'s."""
+    env = dict(os.environ)
+    libs = Path(program).resolve().parent.parent / "lib"
+    if Path(program).resolve().parent.name == "bin" and libs.is_dir():
+        env["LD_LIBRARY_PATH"] = str(libs) + ":" + env.get("LD_LIBRARY_PATH", "")
+    return env
+
+
 class Run:
     def __init__(self, seq, data, variant, args, out, binary, max_frames, repeat=0, seed=1):
         self.seq, self.variant, self.out, self.repeat, self.seed = seq, variant, out, repeat, seed
@@ -98,12 +108,8 @@ class Run:
         self.out.mkdir(parents=True, exist_ok=True)
         self.log = open(self.out / "run.log", "w")
         self.t0 = time.monotonic()
-        env = dict(os.environ)
-        libs = Path(self.cmd[0]).resolve().parent.parent / "lib"
-        if (Path(self.cmd[0]).resolve().parent.name == "bin") and libs.is_dir():
-            # A frozen build (scripts/freeze_build.sh): its own libraries, not build/'s.
-            env["LD_LIBRARY_PATH"] = str(libs) + ":" + env.get("LD_LIBRARY_PATH", "")
-        self.proc = subprocess.Popen(self.cmd, stdout=self.log, stderr=subprocess.STDOUT, env=env)
+        self.proc = subprocess.Popen(self.cmd, stdout=self.log, stderr=subprocess.STDOUT,
+                                     env=program_env(self.cmd[0]))
 
     def reap(self, status, rusage):
         self.wall_s = time.monotonic() - self.t0
@@ -399,9 +405,12 @@ def main():
                     "sequence [%(default)s]")
     ap.add_argument("--bin", default=os.environ.get("ALVIO_RUN", str(ROOT / "build/devel/lib/alvio/alvio_run")))
     ap.add_argument("--freeze", action="store_true",
-                    help="copy the build's programs and libraries into OUT/bin first, so a rebuild "
-                    "during the runs cannot break them")
-    ap.add_argument("--render", action="store_true", help="render missing sequences first (alvio sim --benchmark)")
+                    help="copy the build's programs, libraries and config into OUT/frozen first "
+                    "(refused while a build is running), so that a rebuild during the runs or "
+                    "the rendering cannot break them")
+    ap.add_argument("--render", action="store_true",
+                    help="render missing sequences first (alvio sim --benchmark; with --freeze, "
+                    "the frozen alvio_sim)")
     a = ap.parse_args()
     if a.repeats < 1:
         sys.exit("alvio bench: error: --repeats must be at least 1")
@@ -430,24 +439,9 @@ def main():
         given = [s for s in seqs if Path(s).is_dir()]
         if given:
             sys.exit(f"alvio bench: error: --seeds needs sequence names, not folders ({given[0]})")
-    if a.render:
-        names = [s for s in seqs if not Path(s).is_dir()]
-        sim = Path(a.bin).with_name("alvio_sim")
-        for seed in seeds:
-            subprocess.run([str(sim), "--benchmark", str(seed_set(seed)), "--seed", str(seed),
-                            "--only", ",".join(names)], check=True)
-    datasets = []  # (name, folder, seed)
-    for s in seqs:
-        for seed in seeds:
-            d = Path(s) if Path(s).is_dir() else seed_set(seed) / s
-            if not (d / "mav0").is_dir():
-                sys.exit(f"alvio bench: no sequence {d} (render it: ./alvio sim --benchmark "
-                         f"{seed_set(seed)} --seed {seed} --only {s}, or pass --render)")
-            datasets.append((d.name, d, seed))
-    if any(v in ("sel-lines", "sel-points", "sel-both") for v in variants) and not SURFACES.exists():
-        sys.exit(f"alvio bench: {SURFACES} is missing (make it with ./alvio analyze)")
-
     out = Path(a.out)
+    # Frozen first, so that --render uses the frozen simulator too: a rebuild during a long
+    # rendering would otherwise swap its libraries underneath it.
     if a.freeze:
         env = dict(os.environ, ALVIO_BUILD_DIR=str(Path(a.bin).resolve().parents[3]))
         frozen = subprocess.run([str(ROOT / "scripts/freeze_build.sh"), str(out / "frozen")],
@@ -467,6 +461,22 @@ def main():
         log(f"frozen build: {a.bin}, configuration: {frozen_config}")
     else:
         config_dir = ROOT / "config"
+    if a.render:
+        names = [s for s in seqs if not Path(s).is_dir()]
+        sim = Path(a.bin).with_name("alvio_sim")
+        for seed in seeds:
+            subprocess.run([str(sim), "--benchmark", str(seed_set(seed)), "--seed", str(seed),
+                            "--only", ",".join(names)], check=True, env=program_env(sim))
+    datasets = []  # (name, folder, seed)
+    for s in seqs:
+        for seed in seeds:
+            d = Path(s) if Path(s).is_dir() else seed_set(seed) / s
+            if not (d / "mav0").is_dir():
+                sys.exit(f"alvio bench: no sequence {d} (render it: ./alvio sim --benchmark "
+                         f"{seed_set(seed)} --seed {seed} --only {s}, or pass --render)")
+            datasets.append((d.name, d, seed))
+    if any(v in ("sel-lines", "sel-points", "sel-both") for v in variants) and not SURFACES.exists():
+        sys.exit(f"alvio bench: {SURFACES} is missing (make it with ./alvio analyze)")
 
     def with_config(name, args):
         # A real IMU is weighed by its in-flight noise (config/euroc_real.yaml); the synthetic

@@ -61,6 +61,22 @@ def write_run_folder(folder, seed, lines=True, ate=0.1234, frames=40):
             "lines_used": lines_used, "summary": summary}
 
 
+FAKE_SIM = """#!/usr/bin/python3
+# Stand-in for alvio_sim --benchmark DIR --only NAMES: records how it was started (into the
+# data folder) and makes each sequence's folder.
+import json, os, sys
+from pathlib import Path
+argv = sys.argv
+root = Path(argv[argv.index("--benchmark") + 1])
+data = root if not root.name.startswith("seed") else root.parent
+with open(data / "sim_calls.jsonl", "a") as f:
+    f.write(json.dumps({"argv": argv, "ld_library_path": os.environ.get("LD_LIBRARY_PATH", "")}))
+    f.write("\\n")
+for name in argv[argv.index("--only") + 1].split(","):
+    (root / name / "mav0").mkdir(parents=True, exist_ok=True)
+"""
+
+
 def table_rows(text):
     """Markdown table rows (header and separator excluded) as lists of cells."""
     rows = [line for line in text.splitlines() if line.startswith("|")][2:]
@@ -219,7 +235,7 @@ class TablesTest(unittest.TestCase):
 
 FAKE_RUN = """#!/usr/bin/python3
 # Stand-in for alvio_run: records its arguments and copies the prepared run files.
-import json, shutil, sys
+import json, os, shutil, sys
 from pathlib import Path
 argv = sys.argv[1:]
 out = Path(argv[argv.index("--out") + 1])
@@ -227,7 +243,8 @@ seq = Path(argv[argv.index("--dataset") + 1]).name
 variant = "points" if "--no-lines" in argv else "lines"
 (out / "argv.json").write_text(json.dumps(argv))
 print(f"fake alvio_run: {seq} {variant}")
-src = Path(__file__).parent / "fixtures" / seq / variant
+# FAKE_FIXTURES: where the prepared files are when this script runs from a frozen copy.
+src = Path(os.environ.get("FAKE_FIXTURES", Path(__file__).parent / "fixtures")) / seq / variant
 for f in src.iterdir():
     shutil.copy(f, out / f.name)
 # A nudged noise setting (--repeats) changes the result: ATE scales with it here.
@@ -484,6 +501,37 @@ class MainTest(unittest.TestCase):
             p = self.bench("--sequences", "sim_A", "--seeds", bad)
             self.assertNotEqual(p.returncode, 0)
             self.assertIn("--seeds", p.stderr)
+
+    def test_render_uses_the_frozen_simulator(self):
+        # A build folder as scripts/freeze_build.sh expects it, with a stand-in alvio_sim that
+        # records how it was started and makes the rendering.
+        lib = self.dir / "build" / "devel" / "lib"
+        (lib / "alvio").mkdir(parents=True)
+        (lib / "libalvio_core.so").write_text("core")
+        run = lib / "alvio" / "alvio_run"
+        run.write_text(FAKE_RUN)
+        sim = lib / "alvio" / "alvio_sim"
+        sim.write_text(FAKE_SIM)
+        for program in (run, sim):
+            program.chmod(0o755)
+        out = self.dir / "out"
+        env = dict(os.environ, PYTHONDONTWRITEBYTECODE="1",
+                   FAKE_FIXTURES=str(self.fake.parent / "fixtures"))
+        p = subprocess.run(["/usr/bin/python3", str(SCRIPTS / "bench.py"), "--data", str(self.data),
+                            "--out", str(out), "--bin", str(run), "--freeze", "--render",
+                            "--sequences", "sim_A", "--seeds", "1,3", "--variants", "lines"],
+                           capture_output=True, text=True, env=env, timeout=60)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        calls = [json.loads(line) for line in
+                 (self.data / "sim_calls.jsonl").read_text().splitlines()]
+        self.assertEqual([c["argv"][1:] for c in calls],
+                         [["--benchmark", str(self.data), "--seed", "1", "--only", "sim_A"],
+                          ["--benchmark", str(self.data / "seed3"), "--seed", "3", "--only",
+                           "sim_A"]])
+        for c in calls:
+            self.assertEqual(c["argv"][0], str(out / "frozen" / "bin" / "alvio_sim"))
+            self.assertTrue(c["ld_library_path"].startswith(str(out / "frozen" / "lib")))
+        self.assertTrue((out / "sim_A" / "lines" / "s3" / "summary.json").exists())
 
     def test_missing_sequence_names_it(self):
         p = self.bench("--sequences", "sim_nowhere")
