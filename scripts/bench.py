@@ -466,7 +466,8 @@ def main():
         sim = Path(a.bin).with_name("alvio_sim")
         for seed in seeds:
             subprocess.run([str(sim), "--benchmark", str(seed_set(seed)), "--seed", str(seed),
-                            "--only", ",".join(names)], check=True, env=program_env(sim))
+                            "--only", ",".join(names), "--config", str(config_dir / "euroc.yaml")],
+                           check=True, env=program_env(sim))
     datasets = []  # (name, folder, seed)
     for s in seqs:
         for seed in seeds:

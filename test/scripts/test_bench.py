@@ -524,10 +524,12 @@ class MainTest(unittest.TestCase):
         self.assertEqual(p.returncode, 0, p.stderr)
         calls = [json.loads(line) for line in
                  (self.data / "sim_calls.jsonl").read_text().splitlines()]
+        config = str(out / "frozen" / "config" / "euroc.yaml")
         self.assertEqual([c["argv"][1:] for c in calls],
-                         [["--benchmark", str(self.data), "--seed", "1", "--only", "sim_A"],
+                         [["--benchmark", str(self.data), "--seed", "1", "--only", "sim_A",
+                           "--config", config],
                           ["--benchmark", str(self.data / "seed3"), "--seed", "3", "--only",
-                           "sim_A"]])
+                           "sim_A", "--config", config]])
         for c in calls:
             self.assertEqual(c["argv"][0], str(out / "frozen" / "bin" / "alvio_sim"))
             self.assertTrue(c["ld_library_path"].startswith(str(out / "frozen" / "lib")))
