@@ -37,6 +37,17 @@ void insertIntoBoth(const Vector3d& origin, const std::vector<Vector3d>& points,
   tree->insertPointCloud(cloud, octomap::point3d(origin.x(), origin.y(), origin.z()),
                          map->options().max_range, tree_lazy_eval, /*discretize=*/true);
 }
+
+// The map's tree, log-odds and all (the full .ot format), against `reference` filled by
+// octomap's own lazy insertion, once its inner nodes are updated and pruned as the map's are.
+void expectOctomapsOwnTree(const OccupancyMap& map, octomap::OcTree* reference) {
+  reference->updateInnerOccupancy();
+  reference->prune();
+  std::ostringstream ours, theirs;
+  map.tree().write(ours);
+  reference->write(theirs);
+  EXPECT_EQ(ours.str(), theirs.str());
+}
 }  // namespace
 
 TEST(OccupancyMap, SampledSegmentIsOccupiedAndRaysAreFree) {
@@ -165,12 +176,7 @@ TEST(OccupancyMap, InPlaceUpdatesGiveOctomapsOwnLogOdds) {
       reference.prune();
     }
   }
-  reference.updateInnerOccupancy();
-  reference.prune();
-  std::ostringstream ours, theirs;
-  map.tree().write(ours);
-  reference.write(theirs);
-  EXPECT_EQ(ours.str(), theirs.str());
+  expectOctomapsOwnTree(map, &reference);
   EXPECT_GT(map.counts().occupied, 50u);
 }
 
@@ -194,12 +200,7 @@ TEST(OccupancyMap, CutRaysGiveOctomapsOwnTree) {
                                     : Vector3d(0.1 * k + 2.0, 0.01, 0.01));
     insertIntoBoth(origin, points, &map, &reference, /*tree_lazy_eval=*/true);
   }
-  reference.updateInnerOccupancy();
-  reference.prune();
-  std::ostringstream ours, theirs;
-  map.tree().write(ours);
-  reference.write(theirs);
-  EXPECT_EQ(ours.str(), theirs.str());
+  expectOctomapsOwnTree(map, &reference);
   EXPECT_GT(map.counts().occupied, 20u);
   EXPECT_FALSE(map.isOccupied(Vector3d(4.05, 0.0, 0.0)));  // beyond the range: never occupied
 }
