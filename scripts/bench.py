@@ -82,9 +82,9 @@ def program_env(program):
     """The environment to start one of alvio's programs in: a frozen build's
     (scripts/freeze_build.sh: OUT/bin/<program>) needs its own libraries, not build/'s."""
     env = dict(os.environ)
-    libs = Path(program).resolve().parent.parent / "lib"
-    if Path(program).resolve().parent.name == "bin" and libs.is_dir():
-        env["LD_LIBRARY_PATH"] = str(libs) + ":" + env.get("LD_LIBRARY_PATH", "")
+    folder = Path(program).resolve().parent
+    if folder.name == "bin" and (folder.parent / "lib").is_dir():
+        env["LD_LIBRARY_PATH"] = str(folder.parent / "lib") + ":" + env.get("LD_LIBRARY_PATH", "")
     return env
 
 
