@@ -439,6 +439,23 @@ def main():
         given = [s for s in seqs if Path(s).is_dir()]
         if given:
             sys.exit(f"alvio bench: error: --seeds needs sequence names, not folders ({given[0]})")
+    def sequence_folders():
+        """(name, folder, seed) of every run's input; exits naming the first one missing."""
+        found = []
+        for s in seqs:
+            for seed in seeds:
+                d = Path(s) if Path(s).is_dir() else seed_set(seed) / s
+                if not (d / "mav0").is_dir():
+                    sys.exit(f"alvio bench: no sequence {d} (render it: ./alvio sim --benchmark "
+                             f"{seed_set(seed)} --seed {seed} --only {s}, or pass --render)")
+                found.append((d.name, d, seed))
+        return found
+
+    # Checked before --freeze copies anything, so that a mistyped name leaves no OUT/frozen.
+    if not a.render:
+        sequence_folders()
+    if any(v in ("sel-lines", "sel-points", "sel-both") for v in variants) and not SURFACES.exists():
+        sys.exit(f"alvio bench: {SURFACES} is missing (make it with ./alvio analyze)")
     out = Path(a.out)
     # Frozen first, so that --render uses the frozen simulator too: a rebuild during a long
     # rendering would otherwise swap its libraries underneath it.
@@ -468,16 +485,7 @@ def main():
             subprocess.run([str(sim), "--benchmark", str(seed_set(seed)), "--seed", str(seed),
                             "--only", ",".join(names), "--config", str(config_dir / "euroc.yaml")],
                            check=True, env=program_env(sim))
-    datasets = []  # (name, folder, seed)
-    for s in seqs:
-        for seed in seeds:
-            d = Path(s) if Path(s).is_dir() else seed_set(seed) / s
-            if not (d / "mav0").is_dir():
-                sys.exit(f"alvio bench: no sequence {d} (render it: ./alvio sim --benchmark "
-                         f"{seed_set(seed)} --seed {seed} --only {s}, or pass --render)")
-            datasets.append((d.name, d, seed))
-    if any(v in ("sel-lines", "sel-points", "sel-both") for v in variants) and not SURFACES.exists():
-        sys.exit(f"alvio bench: {SURFACES} is missing (make it with ./alvio analyze)")
+    datasets = sequence_folders()
 
     def with_config(name, args):
         # A real IMU is weighed by its in-flight noise (config/euroc_real.yaml); the synthetic

@@ -540,6 +540,17 @@ class MainTest(unittest.TestCase):
         self.assertIn(str(self.data / "sim_nowhere"), p.stderr)
         self.assertFalse((self.dir / "out" / "results.json").exists())
 
+    def test_missing_sequence_stops_before_freezing(self):
+        # A build folder --freeze could copy: a mistyped name must not leave OUT/frozen behind.
+        run = self.dir / "build" / "devel" / "lib" / "alvio" / "alvio_run"
+        run.parent.mkdir(parents=True)
+        run.write_text(FAKE_RUN)
+        run.chmod(0o755)
+        p = self.bench("--bin", str(run), "--freeze", "--sequences", "sim_A,sim_nowhere")
+        self.assertNotEqual(p.returncode, 0)
+        self.assertIn(str(self.data / "sim_nowhere"), p.stderr)
+        self.assertFalse((self.dir / "out" / "frozen").exists())
+
 
 if __name__ == "__main__":
     unittest.main()
