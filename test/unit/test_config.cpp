@@ -128,6 +128,20 @@ TEST(Config, PointDriftIsReadAndANegativeDriftIsRejected) {
                         {"estimator.point_drift_px2_per_s", "must not be negative"});
 }
 
+TEST(Config, ClaheSettingsAreReadAndNonPositiveOnesAreRejected) {
+  const Config c = Config::load(test::sourcePath("config/euroc.yaml"));
+  EXPECT_DOUBLE_EQ(c.points.clahe_clip_limit, 3.0);
+  EXPECT_EQ(c.points.clahe_tiles, 8);
+  const std::string dir = test::scratchDir();
+  const std::string clip = test::writeFile(
+      dir + "/clip.yaml", eurocYamlReplacing("clahe_clip_limit: 3.0", "clahe_clip_limit: 0"));
+  expectErrorMentioning([&] { Config::load(clip); },
+                        {"points.clahe_clip_limit", "must be positive"});
+  const std::string tiles =
+      test::writeFile(dir + "/tiles.yaml", eurocYamlReplacing("clahe_tiles: 8", "clahe_tiles: 0"));
+  expectErrorMentioning([&] { Config::load(tiles); }, {"points.clahe_tiles", "at least 1"});
+}
+
 TEST(Config, NonRotationExtrinsicIsRejected) {
   const std::string dir = test::scratchDir();
   const std::string path =

@@ -12,7 +12,10 @@ namespace alvio {
 
 PointTracker::PointTracker(const PointTrackerOptions& options,
                            std::shared_ptr<const CameraModel> camera)
-    : options_(options), camera_(std::move(camera)), clahe_(cv::createCLAHE(3.0, cv::Size(8, 8))) {}
+    : options_(options),
+      camera_(std::move(camera)),
+      clahe_(cv::createCLAHE(options.clahe_clip_limit,
+                             cv::Size(options.clahe_tiles, options.clahe_tiles))) {}
 
 void PointTracker::reset() {
   prev_img_.release();

@@ -13,6 +13,8 @@ PointTrackerOptions PointTrackerOptions::load(const YamlReader& yaml, const std:
   o.quality_level = yaml.getDouble(p + "quality_level", o.quality_level);
   o.ransac_threshold_px = yaml.getDouble(p + "ransac_threshold_px", o.ransac_threshold_px);
   o.equalize = yaml.getBool(p + "equalize", o.equalize);
+  o.clahe_clip_limit = yaml.getDouble(p + "clahe_clip_limit", o.clahe_clip_limit);
+  o.clahe_tiles = yaml.getInt(p + "clahe_tiles", o.clahe_tiles);
   o.exposure_jump = yaml.getDouble(p + "exposure_jump", o.exposure_jump);
   o.klt_window = yaml.getInt(p + "klt_window", o.klt_window);
   o.klt_levels = yaml.getInt(p + "klt_levels", o.klt_levels);
@@ -20,6 +22,9 @@ PointTrackerOptions PointTrackerOptions::load(const YamlReader& yaml, const std:
   o.forward_backward_max_px =
       yaml.getDouble(p + "forward_backward_max_px", o.forward_backward_max_px);
   if (o.exposure_jump < 0) throw Error(yaml.where(p + "exposure_jump") + " must not be negative");
+  if (o.clahe_clip_limit <= 0)
+    throw Error(yaml.where(p + "clahe_clip_limit") + " must be positive");
+  if (o.clahe_tiles < 1) throw Error(yaml.where(p + "clahe_tiles") + " must be at least 1");
   if (o.max_features < 8) throw Error(yaml.where(p + "max_features") + " must be at least 8");
   if (o.min_distance_px < 1) throw Error(yaml.where(p + "min_distance_px") + " must be at least 1");
   if (o.klt_window < 5 || o.klt_window % 2 == 0)

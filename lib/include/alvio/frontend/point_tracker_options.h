@@ -13,6 +13,8 @@ struct PointTrackerOptions {
   double quality_level = 0.01;       ///< Shi-Tomasi quality relative to the best corner
   double ransac_threshold_px = 1.0;  ///< fundamental-matrix RANSAC threshold
   bool equalize = true;              ///< CLAHE before tracking (robust to exposure changes)
+  double clahe_clip_limit = 3.0;     ///< CLAHE's contrast limit
+  int clahe_tiles = 8;               ///< CLAHE's tiles per image side
   /// A frame whose mean brightness jumps by more than this fraction is scaled back to the
   /// previous level before point and line tracking (0: off). See exposure_compensation.h.
   double exposure_jump = 0.15;
