@@ -263,6 +263,7 @@ void Estimator::optimize(FrameTiming* timing, int max_iterations) {
 void Estimator::removeReprojectionOutliers() {
   // Mean reprojection error of each landmark over the window, in pixels.
   const double f = camera_.intrinsics[0];
+  const Eigen::Isometry3d T_c_b = T_b_c_.inverse();
   std::vector<int> outliers;
   for (const auto& [id, l] : points_.landmarks()) {
     if (!l.usable(W_) || l.depth <= 0) continue;
@@ -272,7 +273,7 @@ void Estimator::removeReprojectionOutliers() {
     int n = 0;
     for (std::size_t k = 1; k < l.sightings.size(); ++k) {
       const int j = i + static_cast<int>(k);
-      const Eigen::Vector3d p_c = T_b_c_.inverse() * (Rs_[j].transpose() * (p_w - Ps_[j]));
+      const Eigen::Vector3d p_c = T_c_b * (Rs_[j].transpose() * (p_w - Ps_[j]));
       err += (p_c.head<2>() / p_c.z() - l.sightings[k].xy1.head<2>()).norm() * f;
       ++n;
     }
@@ -379,6 +380,7 @@ void Estimator::removeLineOutliers() {
   // Mean endpoint-to-line distance over the window, in pixels; lines that the observed
   // endpoints' rays meet behind a camera go too.
   const double f = camera_.intrinsics[0];
+  const Eigen::Isometry3d T_c_b = T_b_c_.inverse();
   std::vector<int> outliers;
   for (const auto& [id, l] : lines_.landmarks()) {
     if (!lines_.usable(l)) continue;
