@@ -439,6 +439,7 @@ def main():
         given = [s for s in seqs if Path(s).is_dir()]
         if given:
             sys.exit(f"alvio bench: error: --seeds needs sequence names, not folders ({given[0]})")
+
     def sequence_folders():
         """(name, folder, seed) of every run's input; exits naming the first one missing."""
         found = []

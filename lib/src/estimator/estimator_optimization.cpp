@@ -380,7 +380,6 @@ void Estimator::removeLineOutliers() {
   // Mean endpoint-to-line distance over the window, in pixels; lines that the observed
   // endpoints' rays meet behind a camera go too.
   const double f = camera_.intrinsics[0];
-  const Eigen::Isometry3d T_c_b = T_b_c_.inverse();
   std::vector<int> outliers;
   for (const auto& [id, l] : lines_.landmarks()) {
     if (!lines_.usable(l)) continue;
