@@ -452,9 +452,10 @@ def main():
                 found.append((d.name, d, seed))
         return found
 
-    # Checked before --freeze copies anything, so that a mistyped name leaves no OUT/frozen.
+    # Checked before --freeze copies anything, so that a mistyped name leaves no OUT/frozen;
+    # with --render, once the rendering is done.
     if not a.render:
-        sequence_folders()
+        datasets = sequence_folders()
     if any(v in ("sel-lines", "sel-points", "sel-both") for v in variants) and not SURFACES.exists():
         sys.exit(f"alvio bench: {SURFACES} is missing (make it with ./alvio analyze)")
     out = Path(a.out)
@@ -486,7 +487,7 @@ def main():
             subprocess.run([str(sim), "--benchmark", str(seed_set(seed)), "--seed", str(seed),
                             "--only", ",".join(names), "--config", str(config_dir / "euroc.yaml")],
                            check=True, env=program_env(sim))
-    datasets = sequence_folders()
+        datasets = sequence_folders()
 
     def with_config(name, args):
         # A real IMU is weighed by its in-flight noise (config/euroc_real.yaml); the synthetic
