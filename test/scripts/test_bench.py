@@ -504,18 +504,20 @@ class MainTest(unittest.TestCase):
             self.assertNotEqual(p.returncode, 0)
             self.assertIn("--seeds", p.stderr)
 
-    def test_render_uses_the_frozen_simulator(self):
-        # A build folder as scripts/freeze_build.sh expects it, with a stand-in alvio_sim that
-        # records how it was started and makes the rendering.
+    def fake_build(self):
+        """A build folder as scripts/freeze_build.sh expects it: a library, the stand-in
+        alvio_run and a stand-in alvio_sim that records how it was started and makes the
+        rendering. Returns alvio_run's path."""
         lib = self.dir / "build" / "devel" / "lib"
         (lib / "alvio").mkdir(parents=True)
         (lib / "libalvio_core.so").write_text("core")
-        run = lib / "alvio" / "alvio_run"
-        run.write_text(FAKE_RUN)
-        sim = lib / "alvio" / "alvio_sim"
-        sim.write_text(FAKE_SIM)
-        for program in (run, sim):
-            program.chmod(0o755)
+        for name, text in (("alvio_run", FAKE_RUN), ("alvio_sim", FAKE_SIM)):
+            (lib / "alvio" / name).write_text(text)
+            (lib / "alvio" / name).chmod(0o755)
+        return lib / "alvio" / "alvio_run"
+
+    def test_render_uses_the_frozen_simulator(self):
+        run = self.fake_build()
         out = self.dir / "out"
         # The last --bin counts: this build's alvio_run instead of the stand-in's.
         p = self.bench("--bin", str(run), "--freeze", "--render", "--sequences", "sim_A",
@@ -541,12 +543,8 @@ class MainTest(unittest.TestCase):
         self.assertFalse((self.dir / "out" / "results.json").exists())
 
     def test_missing_sequence_stops_before_freezing(self):
-        # A build folder --freeze could copy: a mistyped name must not leave OUT/frozen behind.
-        run = self.dir / "build" / "devel" / "lib" / "alvio" / "alvio_run"
-        run.parent.mkdir(parents=True)
-        run.write_text(FAKE_RUN)
-        run.chmod(0o755)
-        p = self.bench("--bin", str(run), "--freeze", "--sequences", "sim_A,sim_nowhere")
+        # A build --freeze could copy: a mistyped name must not leave OUT/frozen behind.
+        p = self.bench("--bin", str(self.fake_build()), "--freeze", "--sequences", "sim_A,sim_nowhere")
         self.assertNotEqual(p.returncode, 0)
         self.assertIn(str(self.data / "sim_nowhere"), p.stderr)
         self.assertFalse((self.dir / "out" / "frozen").exists())
