@@ -3,8 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <cmath>
 #include <filesystem>
+#include <functional>
 #include <iostream>
 #include <map>
 #include <opencv2/imgcodecs.hpp>
@@ -115,8 +115,9 @@ TEST(LineDetector, LargerLsdQuantSkipsFaintEdges) {
 TEST(LineDetector, LsdOnAScaledImageFindsStepEdgesWhereTheyAre) {
   // A bright quadrant x > ex, y > ey, pixels shaded by the area they cover (pixel u spans
   // [u - 0.5, u + 0.5]), at ten sub-pixel positions. Before the scale shift, lsd_scale 0.5
-  // put every edge 0.5 px up and left.
-  for (double scale : {1.0, 0.5}) {
+  // put every edge 0.5 px up and left. The pyramid's half image is centred differently.
+  for (const auto& [scale, pyramid] : {std::pair{1.0, false}, {0.5, false}, {0.5, true}}) {
+    const std::string what = "scale " + std::to_string(scale) + (pyramid ? " (pyramid)" : "");
     double sum_x = 0, sum_y = 0;
     int n_x = 0, n_y = 0;
     for (int k = 0; k < 10; ++k) {
@@ -130,23 +131,24 @@ TEST(LineDetector, LsdOnAScaledImageFindsStepEdgesWhereTheyAre) {
         }
       LineDetectorOptions o;
       o.lsd_scale = scale;
+      o.lsd_pyramid_downscale = pyramid;
       for (const LineSegment& s : LineDetector(o, kSize).detect(image)) {
         const Eigen::Vector2d d = s.end - s.start;
         if (std::abs(d.x()) < 1 && s.length() > 100) {
-          EXPECT_NEAR(s.midpoint().x(), ex, 0.2) << "scale " << scale;
+          EXPECT_NEAR(s.midpoint().x(), ex, 0.2) << what;
           sum_x += s.midpoint().x() - ex;
           ++n_x;
         } else if (std::abs(d.y()) < 1 && s.length() > 100) {
-          EXPECT_NEAR(s.midpoint().y(), ey, 0.2) << "scale " << scale;
+          EXPECT_NEAR(s.midpoint().y(), ey, 0.2) << what;
           sum_y += s.midpoint().y() - ey;
           ++n_y;
         }
       }
     }
-    ASSERT_EQ(n_x, 10) << "scale " << scale;
-    ASSERT_EQ(n_y, 10) << "scale " << scale;
-    EXPECT_NEAR(sum_x / n_x, 0.0, 0.05) << "mean x offset at scale " << scale;
-    EXPECT_NEAR(sum_y / n_y, 0.0, 0.05) << "mean y offset at scale " << scale;
+    ASSERT_EQ(n_x, 10) << what;
+    ASSERT_EQ(n_y, 10) << what;
+    EXPECT_NEAR(sum_x / n_x, 0.0, 0.05) << "mean x offset, " << what;
+    EXPECT_NEAR(sum_y / n_y, 0.0, 0.05) << "mean y offset, " << what;
   }
 }
 
@@ -160,6 +162,41 @@ bool hasCounterpart(const cv::Vec4f& s, const std::vector<cv::Vec4f>& b) {
 double lengthOf(const cv::Vec4f& s) {
   return std::hypot(s[2] - s[0], s[3] - s[1]);
 }
+// Does `b` have a segment on the same line as `s` (both endpoints within 1 px of it) that
+// covers at least half of the shorter of the two?
+bool hasCollinearCounterpart(const cv::Vec4f& s, const std::vector<cv::Vec4f>& b) {
+  const LineSegment a({s[0], s[1]}, {s[2], s[3]});
+  return std::any_of(b.begin(), b.end(), [&](const cv::Vec4f& t) {
+    const LineSegment c({t[0], t[1]}, {t[2], t[3]});
+    return a.distanceToLine(c.start) < 1 && a.distanceToLine(c.end) < 1 &&
+           projectedOverlap(a, c) >= 0.5 * std::min(a.length(), c.length());
+  });
+}
+
+using Detect = std::function<void(const cv::Mat&, std::vector<cv::Vec4f>*)>;
+using Counterpart = std::function<bool(const cv::Vec4f&, const std::vector<cv::Vec4f>&)>;
+struct Agreement {
+  int first = 0, first_found = 0, second = 0, second_found = 0;
+};
+// Runs both detectors on ten of the real EuRoC frames and counts, for each, its segments at
+// least as long as the tracker keeps that have a counterpart among the other's.
+Agreement compareOnRealFrames(const std::vector<std::string>& files, const Detect& first,
+                              const Detect& second, const Counterpart& counterpart) {
+  const double shortest = LineDetector(LineDetectorOptions(), kSize).shortestLength();
+  Agreement n;
+  for (std::size_t i = 0; i < files.size(); i += files.size() / 10) {
+    const cv::Mat image = cv::imread(files[i], cv::IMREAD_GRAYSCALE);
+    EXPECT_FALSE(image.empty()) << files[i];
+    std::vector<cv::Vec4f> a, b;
+    first(image, &a);
+    second(image, &b);
+    for (const cv::Vec4f& s : a)
+      if (lengthOf(s) >= shortest) n.first_found += counterpart(s, b), ++n.first;
+    for (const cv::Vec4f& s : b)
+      if (lengthOf(s) >= shortest) n.second_found += counterpart(s, a), ++n.second;
+  }
+  return n;
+}
 }  // namespace
 
 TEST(LinearTimeLsd, FindsOpenCvsSegmentsOnRealEuRoCFrames) {
@@ -172,24 +209,37 @@ TEST(LinearTimeLsd, FindsOpenCvsSegmentsOnRealEuRoCFrames) {
   const auto opencv = cv::createLineSegmentDetector(cv::LSD_REFINE_NONE, o.lsd_scale,
                                                     o.lsd_sigma_scale, o.lsd_quant);
   LinearTimeLsd linear(o.lsd_scale, o.lsd_sigma_scale, o.lsd_quant);
-  const double shortest = LineDetector(o, kSize).shortestLength();
-  int theirs = 0, theirs_found = 0, ours = 0, ours_found = 0;
-  for (std::size_t i = 0; i < files.size(); i += files.size() / 10) {
-    const cv::Mat image = cv::imread(files[i], cv::IMREAD_GRAYSCALE);
-    ASSERT_FALSE(image.empty()) << files[i];
-    std::vector<cv::Vec4f> a, b;
-    opencv->detect(image, a);
-    linear.detect(image, &b);
-    for (const cv::Vec4f& s : a)
-      if (lengthOf(s) >= shortest) theirs_found += hasCounterpart(s, b), ++theirs;
-    for (const cv::Vec4f& s : b)
-      if (lengthOf(s) >= shortest) ours_found += hasCounterpart(s, a), ++ours;
-  }
-  std::cout << theirs_found << " of OpenCV's " << theirs << " segments found, " << ours_found
-            << " of ours " << ours << " found by OpenCV\n";
-  ASSERT_GT(theirs, 500);
-  EXPECT_GE(theirs_found, 0.98 * theirs);
-  EXPECT_GE(ours_found, 0.98 * ours);
+  const Agreement n = compareOnRealFrames(
+      files,
+      [&](const cv::Mat& image, std::vector<cv::Vec4f>* out) { opencv->detect(image, *out); },
+      [&](const cv::Mat& image, std::vector<cv::Vec4f>* out) { linear.detect(image, out); },
+      hasCounterpart);
+  std::cout << n.first_found << " of OpenCV's " << n.first << " segments found, " << n.second_found
+            << " of ours " << n.second << " found by OpenCV\n";
+  ASSERT_GT(n.first, 500);
+  EXPECT_GE(n.first_found, 0.98 * n.first);
+  EXPECT_GE(n.second_found, 0.98 * n.second);
+}
+
+TEST(LinearTimeLsd, PyramidDownscaleFindsTheBlurredImagesLines) {
+  // pyrDown's 5-tap kernel (sigma about 1 px) against the 1.2 px Gaussian and a resize: a
+  // slightly sharper half image. Endpoints move along their lines (region growing stops
+  // elsewhere), but most long segments must lie on the same lines.
+  const std::vector<std::string> files = test::sharedEurocImages();
+  if (files.empty()) GTEST_SKIP() << "../shared/data not found: no real EuRoC frames to compare on";
+  ASSERT_GE(files.size(), 10u);
+  const LineDetectorOptions o;
+  LinearTimeLsd blurred(0.5, o.lsd_sigma_scale, o.lsd_quant);
+  LinearTimeLsd pyramid(0.5, o.lsd_sigma_scale, o.lsd_quant, true);
+  const Agreement n = compareOnRealFrames(
+      files, [&](const cv::Mat& image, std::vector<cv::Vec4f>* out) { blurred.detect(image, out); },
+      [&](const cv::Mat& image, std::vector<cv::Vec4f>* out) { pyramid.detect(image, out); },
+      hasCollinearCounterpart);
+  std::cout << n.first_found << " of the blurred image's " << n.first << " segments found, "
+            << n.second_found << " of the pyramid's " << n.second << "\n";
+  ASSERT_GT(n.first, 500);
+  EXPECT_GE(n.first_found, 0.8 * n.first);
+  EXPECT_GE(n.second_found, 0.8 * n.second);
 }
 
 TEST(LinearTimeLsd, AnImageWithoutEdgesHasNoSegments) {
@@ -208,6 +258,19 @@ TEST(LineDetector, RefinementNeedsOpenCvsLsd) {
             std::string::npos);
   o.method = "opencv_lsd";
   EXPECT_NO_THROW(o.validate("lines.detector"));
+}
+
+TEST(LineDetector, PyramidDownscaleNeedsLsdAtHalfScale) {
+  LineDetectorOptions o;
+  o.lsd_pyramid_downscale = true;
+  EXPECT_NO_THROW(o.validate("lines.detector"));
+  o.lsd_scale = 0.6;
+  EXPECT_NE(test::errorOf([&] { o.validate("lines.detector"); }).find("lsd_pyramid_downscale"),
+            std::string::npos);
+  o.lsd_scale = 0.5;
+  o.method = "opencv_lsd";
+  EXPECT_NE(test::errorOf([&] { o.validate("lines.detector"); }).find("lsd_pyramid_downscale"),
+            std::string::npos);
 }
 
 TEST(LineDetector, FldOnAScaledImageReturnsFullResolutionSegments) {

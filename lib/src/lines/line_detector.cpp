@@ -25,7 +25,7 @@ LineDetector::LineDetector(const LineDetectorOptions& options, cv::Size image_si
         options_.lsd_sigma_scale, options_.lsd_quant);
   else
     lsd_ = std::make_unique<LinearTimeLsd>(options_.lsd_scale, options_.lsd_sigma_scale,
-                                           options_.lsd_quant);
+                                           options_.lsd_quant, options_.lsd_pyramid_downscale);
 }
 
 namespace {

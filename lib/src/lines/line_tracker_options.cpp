@@ -37,6 +37,7 @@ LineDetectorOptions LineDetectorOptions::load(const YamlReader& yaml, const std:
   o.lsd_scale = yaml.getDouble(p + "lsd_scale", o.lsd_scale);
   o.fld_scale = yaml.getDouble(p + "fld_scale", o.fld_scale);
   o.lsd_sigma_scale = yaml.getDouble(p + "lsd_sigma_scale", o.lsd_sigma_scale);
+  o.lsd_pyramid_downscale = yaml.getBool(p + "lsd_pyramid_downscale", o.lsd_pyramid_downscale);
   o.lsd_refine = yaml.getBool(p + "lsd_refine", o.lsd_refine);
   o.lsd_quant = yaml.getDouble(p + "lsd_quant", o.lsd_quant);
   o.border_margin_px = yaml.getInt(p + "border_margin_px", o.border_margin_px);
@@ -50,6 +51,8 @@ void LineDetectorOptions::validate(const std::string& where) const {
     throw Error(where + ": key 'method' must be lsd, opencv_lsd or fld, got '" + method + "'");
   if (lsd_refine && method != "opencv_lsd")
     throw Error(where + ": key 'lsd_refine' needs method opencv_lsd (got method '" + method + "')");
+  if (lsd_pyramid_downscale && (method != "lsd" || lsd_scale != 0.5))
+    throw Error(where + ": key 'lsd_pyramid_downscale' needs method lsd and lsd_scale 0.5");
   require(min_length_ratio > 0 && min_length_ratio < 1, where, "min_length_ratio", "in (0, 1)",
           min_length_ratio);
   require(continuation_length_factor > 0 && continuation_length_factor <= 1, where,

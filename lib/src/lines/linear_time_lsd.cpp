@@ -16,9 +16,13 @@ constexpr float kUndefined = -1024.0f;
 constexpr double kDegToRad = CV_PI / 180.0;
 }  // namespace
 
-LinearTimeLsd::LinearTimeLsd(double scale, double sigma_scale, double quant)
-    : scale_(scale), sigma_scale_(sigma_scale), threshold_(quant / std::sin(kTolerance)) {
+LinearTimeLsd::LinearTimeLsd(double scale, double sigma_scale, double quant, bool pyramid_downscale)
+    : scale_(scale),
+      sigma_scale_(sigma_scale),
+      threshold_(quant / std::sin(kTolerance)),
+      pyramid_downscale_(pyramid_downscale) {
   CV_Assert(scale > 0 && scale <= 1 && sigma_scale > 0 && quant > 0);
+  CV_Assert(!pyramid_downscale || scale == 0.5);
 }
 
 void LinearTimeLsd::detect(const cv::Mat& gray, std::vector<cv::Vec4f>* segments) {
@@ -26,7 +30,13 @@ void LinearTimeLsd::detect(const cv::Mat& gray, std::vector<cv::Vec4f>* segments
   segments->clear();
   // No 2x2 gradient fits into a smaller image.
   if (cvRound(gray.cols * scale_) < 2 || cvRound(gray.rows * scale_) < 2) return;
-  if (scale_ != 1) {
+  // Where a scaled pixel's centre lies in the input image, against resize's 2 u_s + 0.5.
+  double centre_shift = 0.0;
+  if (pyramid_downscale_) {
+    cv::pyrDown(gray, scaled_);
+    // pyrDown centres scaled pixel u_s on input pixel 2 u_s.
+    centre_shift = -0.5;
+  } else if (scale_ != 1) {
     // The blur that keeps the scaled image free of aliasing: sigma = sigma_scale / scale,
     // truncated where the kernel falls under 10^-3.
     const double sigma = sigma_scale_ / scale_;
@@ -54,8 +64,8 @@ void LinearTimeLsd::detect(const cv::Mat& gray, std::vector<cv::Vec4f>* segments
     if (region_.size() < min_region) continue;
     const cv::Vec4d s = regionToSegment(region_angle);
     // Pixel centres are at +0.5, then back to the input image.
-    segments->emplace_back(float((s[0] + 0.5) / scale_), float((s[1] + 0.5) / scale_),
-                           float((s[2] + 0.5) / scale_), float((s[3] + 0.5) / scale_));
+    auto out = [&](double u) { return float((u + 0.5) / scale_ + centre_shift); };
+    segments->emplace_back(out(s[0]), out(s[1]), out(s[2]), out(s[3]));
   }
 }
 

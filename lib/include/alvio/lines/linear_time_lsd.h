@@ -20,10 +20,13 @@ class LinearTimeLsd {
  public:
   /// `scale` and `sigma_scale` as OpenCV's (sigma = sigma_scale / scale when scale < 1);
   /// `quant` bounds the gradient's quantisation error (threshold quant / sin(22.5 deg)).
-  LinearTimeLsd(double scale, double sigma_scale, double quant);
+  /// `pyramid_downscale` (scale 0.5 only): halve the image with cv::pyrDown's 5-tap Gaussian
+  /// instead of the sigma_scale blur and a resize, several times cheaper (docs/benchmarks.md).
+  LinearTimeLsd(double scale, double sigma_scale, double quant, bool pyramid_downscale = false);
 
   /// Segments (x1, y1, x2, y2) in the input image's pixels, in OpenCV's convention: a scaled
-  /// image coordinate u_s comes back as (u_s + 0.5) / scale. `gray` is CV_8UC1.
+  /// image coordinate u_s comes back as (u_s + 0.5) / scale, whichever way the image was scaled.
+  /// `gray` is CV_8UC1.
   void detect(const cv::Mat& gray, std::vector<cv::Vec4f>* segments);
 
  private:
@@ -43,6 +46,7 @@ class LinearTimeLsd {
   bool aligned(int index, double angle) const;
 
   double scale_, sigma_scale_, threshold_;
+  bool pyramid_downscale_;
   cv::Mat blurred_, scaled_;
   int width_ = 0, height_ = 0;
   std::vector<float> angle_;     // gradient direction [rad], or kUndefined
