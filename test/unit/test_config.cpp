@@ -142,6 +142,24 @@ TEST(Config, ClaheSettingsAreReadAndNonPositiveOnesAreRejected) {
   expectErrorMentioning([&] { Config::load(tiles); }, {"points.clahe_tiles", "at least 1"});
 }
 
+TEST(Config, PatchAnchorSettingsAreReadAndBadOnesAreRejected) {
+  const Config c = Config::load(test::sourcePath("config/euroc.yaml"));
+  EXPECT_EQ(c.points.anchors.window, 21);
+  EXPECT_DOUBLE_EQ(c.points.anchors.max_shift_px, 1.0);
+  EXPECT_EQ(c.points.anchors.reanchor_frames, 20);
+  const std::string dir = test::scratchDir();
+  const std::string window =
+      test::writeFile(dir + "/window.yaml", eurocYamlReplacing("    window: 21", "    window: 20"));
+  expectErrorMentioning([&] { Config::load(window); }, {"points.anchors.window", "odd"});
+  const std::string shift = test::writeFile(
+      dir + "/shift.yaml", eurocYamlReplacing("max_shift_px: 1.0", "max_shift_px: 0"));
+  expectErrorMentioning([&] { Config::load(shift); },
+                        {"points.anchors.max_shift_px", "must be positive"});
+  const std::string zncc =
+      test::writeFile(dir + "/zncc.yaml", eurocYamlReplacing("min_zncc: 0.5", "min_zncc: 1.5"));
+  expectErrorMentioning([&] { Config::load(zncc); }, {"points.anchors.min_zncc", "[-1, 1]"});
+}
+
 TEST(Config, NonRotationExtrinsicIsRejected) {
   const std::string dir = test::scratchDir();
   const std::string path =

@@ -15,7 +15,8 @@ PointTracker::PointTracker(const PointTrackerOptions& options,
     : options_(options),
       camera_(std::move(camera)),
       clahe_(cv::createCLAHE(options.clahe_clip_limit,
-                             cv::Size(options.clahe_tiles, options.clahe_tiles))) {}
+                             cv::Size(options.clahe_tiles, options.clahe_tiles))),
+      anchors_(options.anchors) {}
 
 void PointTracker::reset() {
   prev_img_.release();
@@ -24,6 +25,7 @@ void PointTracker::reset() {
   track_counts_.clear();
   prev_xy_.clear();
   prev_ids_.clear();
+  anchors_.clear();
 }
 
 namespace {
@@ -111,6 +113,7 @@ FeatureFrame PointTracker::track(const cv::Mat& gray, int64_t t_ns, FrameTiming*
       keep(&track_counts_, status);
       rejectWithFundamental(&prev, &next, &ids_, &track_counts_);
       pts_ = next;
+      if (options_.anchors.enabled) alignToAnchors(img);
     } else {
       pts_.clear();
       ids_.clear();
@@ -122,6 +125,11 @@ FeatureFrame PointTracker::track(const cv::Mat& gray, int64_t t_ns, FrameTiming*
   {
     ScopedStage stage(timing, "point_detection");
     detectNew(img);
+    if (options_.anchors.enabled) {
+      anchors_.keepOnly(ids_);
+      for (std::size_t i = 0; i < pts_.size(); ++i)
+        if (track_counts_[i] == 1) anchors_.anchor(ids_[i], img, pts_[i]);
+    }
   }
 
   // Normalised coordinates and their velocities against the previous frame.
@@ -146,6 +154,16 @@ FeatureFrame PointTracker::track(const cv::Mat& gray, int64_t t_ns, FrameTiming*
   prev_img_ = img;
   prev_t_ns_ = t_ns;
   return frame;
+}
+
+void PointTracker::alignToAnchors(const cv::Mat& img) {
+  anchors_.tick();
+  for (std::size_t i = 0; i < pts_.size(); ++i) {
+    // A patch that no longer aligns (the view changed too much) or has served long enough is
+    // taken again where KLT put the track.
+    if (!anchors_.refine(ids_[i], img, &pts_[i]) || anchors_.dueForReanchor(ids_[i]))
+      anchors_.anchor(ids_[i], img, pts_[i]);
+  }
 }
 
 void PointTracker::detectNew(const cv::Mat& img) {

@@ -21,6 +21,22 @@ PointTrackerOptions PointTrackerOptions::load(const YamlReader& yaml, const std:
   o.forward_backward_check = yaml.getBool(p + "forward_backward_check", o.forward_backward_check);
   o.forward_backward_max_px =
       yaml.getDouble(p + "forward_backward_max_px", o.forward_backward_max_px);
+  const std::string a = p + "anchors.";
+  PatchAnchorOptions& an = o.anchors;
+  an.enabled = yaml.getBool(a + "enabled", an.enabled);
+  an.window = yaml.getInt(a + "window", an.window);
+  an.max_shift_px = yaml.getDouble(a + "max_shift_px", an.max_shift_px);
+  an.reanchor_frames = yaml.getInt(a + "reanchor_frames", an.reanchor_frames);
+  an.max_iterations = yaml.getInt(a + "max_iterations", an.max_iterations);
+  an.min_zncc = yaml.getDouble(a + "min_zncc", an.min_zncc);
+  if (an.window < 5 || an.window % 2 == 0)
+    throw Error(yaml.where(a + "window") + " must be an odd number >= 5");
+  if (an.max_shift_px <= 0) throw Error(yaml.where(a + "max_shift_px") + " must be positive");
+  if (an.reanchor_frames < 0)
+    throw Error(yaml.where(a + "reanchor_frames") + " must not be negative");
+  if (an.max_iterations < 1) throw Error(yaml.where(a + "max_iterations") + " must be at least 1");
+  if (an.min_zncc < -1 || an.min_zncc > 1)
+    throw Error(yaml.where(a + "min_zncc") + " must be within [-1, 1]");
   if (o.exposure_jump < 0) throw Error(yaml.where(p + "exposure_jump") + " must not be negative");
   if (o.clahe_clip_limit <= 0)
     throw Error(yaml.where(p + "clahe_clip_limit") + " must be positive");

@@ -13,6 +13,7 @@
 #include "alvio/common/timing.h"
 #include "alvio/frontend/corner_detector.h"
 #include "alvio/frontend/feature_frame.h"
+#include "alvio/frontend/patch_anchors.h"
 #include "alvio/frontend/point_tracker_options.h"
 
 namespace alvio {
@@ -35,11 +36,13 @@ class PointTracker {
   void rejectWithFundamental(std::vector<cv::Point2f>* prev, std::vector<cv::Point2f>* cur,
                              std::vector<int>* ids, std::vector<int>* counts) const;
   void detectNew(const cv::Mat& img);
+  void alignToAnchors(const cv::Mat& img);
 
   PointTrackerOptions options_;
   std::shared_ptr<const CameraModel> camera_;
   cv::Ptr<cv::CLAHE> clahe_;
   CornerDetector corners_;
+  PatchAnchors anchors_;
   cv::Mat prev_img_;
   int64_t prev_t_ns_ = 0;
   std::vector<cv::Point2f> pts_;

@@ -3,6 +3,8 @@
 
 #include <string>
 
+#include "alvio/frontend/patch_anchors.h"
+
 namespace alvio {
 
 class YamlReader;
@@ -22,6 +24,7 @@ struct PointTrackerOptions {
   int klt_levels = 3;
   bool forward_backward_check = true;  ///< track back and reject points that do not return
   double forward_backward_max_px = 0.5;
+  PatchAnchorOptions anchors;  ///< `points.anchors`: align each track to its anchored patch
 
   static PointTrackerOptions load(const YamlReader& yaml, const std::string& prefix);
 };

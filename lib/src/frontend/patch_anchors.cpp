@@ -1,0 +1,135 @@
+#include "alvio/frontend/patch_anchors.h"
+
+#include <algorithm>
+#include <cmath>
+#include <unordered_set>
+
+namespace alvio {
+namespace {
+
+// Bilinear samples of the side x side grid (unit steps) centred on p. All samples share p's
+// fractional part, so the four weights are computed once. False where the grid (and the
+// pixel right and below each sample) leaves the image.
+bool samplePatch(const cv::Mat& image, const cv::Point2f& p, int side, float* out) {
+  const int h = side / 2;
+  const float x0 = p.x - h, y0 = p.y - h;
+  if (!(x0 >= 0.f && y0 >= 0.f)) return false;  // also NaN
+  const int ix = static_cast<int>(x0), iy = static_cast<int>(y0);
+  if (ix + side >= image.cols || iy + side >= image.rows) return false;
+  const float fx = x0 - ix, fy = y0 - iy;
+  const float w00 = (1 - fx) * (1 - fy), w01 = fx * (1 - fy), w10 = (1 - fx) * fy, w11 = fx * fy;
+  for (int r = 0; r < side; ++r) {
+    const uchar* a = image.ptr<uchar>(iy + r) + ix;
+    const uchar* b = image.ptr<uchar>(iy + r + 1) + ix;
+    for (int c = 0; c < side; ++c)
+      *out++ = w00 * a[c] + w01 * a[c + 1] + w10 * b[c] + w11 * b[c + 1];
+  }
+  return true;
+}
+
+}  // namespace
+
+PatchAnchors::PatchAnchors(const PatchAnchorOptions& options) : options_(options) {}
+
+bool PatchAnchors::anchor(int id, const cv::Mat& image, const cv::Point2f& p) {
+  const int n = options_.window, m = n + 2;  // one pixel more each side for the gradients
+  std::vector<float> big(m * m);
+  if (!samplePatch(image, p, m, big.data())) return false;
+  Patch patch;
+  patch.values.resize(n * n);
+  patch.gx.resize(n * n);
+  patch.gy.resize(n * n);
+  double sum = 0;
+  for (int r = 0; r < n; ++r)
+    for (int c = 0; c < n; ++c) {
+      const int k = r * n + c, b = (r + 1) * m + (c + 1);
+      patch.values[k] = big[b];
+      patch.gx[k] = 0.5f * (big[b + 1] - big[b - 1]);
+      patch.gy[k] = 0.5f * (big[b + m] - big[b - m]);
+      sum += big[b];
+    }
+  const float mean = static_cast<float>(sum / (n * n));
+  double h00 = 0, h01 = 0, h11 = 0, ss = 0;
+  for (int k = 0; k < n * n; ++k) {
+    patch.values[k] -= mean;
+    ss += patch.values[k] * patch.values[k];
+    h00 += patch.gx[k] * patch.gx[k];
+    h01 += patch.gx[k] * patch.gy[k];
+    h11 += patch.gy[k] * patch.gy[k];
+  }
+  const double det = h00 * h11 - h01 * h01;
+  if (!(det > 1e-6 * (h00 + h11) * (h00 + h11)) || ss <= 0) return false;  // no 2D texture
+  patch.inv_h00 = h11 / det;
+  patch.inv_h01 = -h01 / det;
+  patch.inv_h11 = h00 / det;
+  patch.norm = static_cast<float>(std::sqrt(ss));
+  patches_[id] = std::move(patch);
+  return true;
+}
+
+bool PatchAnchors::refine(int id, const cv::Mat& image, cv::Point2f* p) const {
+  const auto it = patches_.find(id);
+  if (it == patches_.end()) return false;
+  const Patch& t = it->second;
+  const int n = options_.window, count = n * n;
+  thread_local std::vector<float> cur;
+  cur.resize(count);
+  cv::Point2f q = *p;
+  bool converged = false;
+  double zncc = 0;
+  for (int iter = 0; iter < options_.max_iterations; ++iter) {
+    if (!samplePatch(image, q, n, cur.data())) return false;
+    double sum = 0;
+    for (int k = 0; k < count; ++k) sum += cur[k];
+    const float mean = static_cast<float>(sum / count);
+    double ss = 0, cross = 0;
+    for (int k = 0; k < count; ++k) {
+      cur[k] -= mean;
+      ss += cur[k] * cur[k];
+      cross += cur[k] * t.values[k];
+    }
+    if (ss <= 0) return false;
+    zncc = cross / (std::sqrt(ss) * t.norm);
+    // The image patch scaled to the template's contrast, minus the template.
+    const float gain = static_cast<float>(t.norm / std::sqrt(ss));
+    double bx = 0, by = 0;
+    for (int k = 0; k < count; ++k) {
+      const float e = gain * cur[k] - t.values[k];
+      bx += t.gx[k] * e;
+      by += t.gy[k] * e;
+    }
+    // Inverse compositional: the template's step, applied inverted to the image position.
+    const double dx = t.inv_h00 * bx + t.inv_h01 * by;
+    const double dy = t.inv_h01 * bx + t.inv_h11 * by;
+    q.x -= static_cast<float>(dx);
+    q.y -= static_cast<float>(dy);
+    if (dx * dx + dy * dy < 1e-4) {
+      converged = true;
+      break;
+    }
+  }
+  const float sx = q.x - p->x, sy = q.y - p->y;
+  if (!converged || zncc < options_.min_zncc ||
+      sx * sx + sy * sy > options_.max_shift_px * options_.max_shift_px)
+    return false;
+  *p = q;
+  return true;
+}
+
+bool PatchAnchors::dueForReanchor(int id) const {
+  if (options_.reanchor_frames <= 0) return false;
+  const auto it = patches_.find(id);
+  return it == patches_.end() || it->second.age >= options_.reanchor_frames;
+}
+
+void PatchAnchors::tick() {
+  for (auto& [id, patch] : patches_) ++patch.age;
+}
+
+void PatchAnchors::keepOnly(const std::vector<int>& ids) {
+  const std::unordered_set<int> keep(ids.begin(), ids.end());
+  for (auto it = patches_.begin(); it != patches_.end();)
+    it = keep.count(it->first) ? std::next(it) : patches_.erase(it);
+}
+
+}  // namespace alvio

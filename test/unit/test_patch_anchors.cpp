@@ -1,0 +1,151 @@
+// Anchored patch refinement: it finds a sub-pixel shift under a change of brightness and
+// contrast, refuses what it must not take (too far, another patch, off the image), and on a
+// noisy sequence keeps the track's error bounded where frame-to-frame KLT lets it grow.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
+#include <vector>
+
+#include "alvio/frontend/patch_anchors.h"
+
+using namespace alvio;
+
+namespace {
+// A smooth random texture, grey levels from lo to hi.
+cv::Mat texture(cv::Size size, int seed, double lo = 20, double hi = 235) {
+  cv::Mat noise(size, CV_32FC1);
+  cv::RNG rng(seed);
+  rng.fill(noise, cv::RNG::UNIFORM, 0, 255);
+  cv::GaussianBlur(noise, noise, cv::Size(0, 0), 2.0);
+  cv::normalize(noise, noise, lo, hi, cv::NORM_MINMAX);
+  return noise;
+}
+
+// `base` moved by (dx, dy) (content at x in base appears at x + d), times gain plus offset,
+// plus white noise of sigma DN, as 8-bit.
+cv::Mat shifted(const cv::Mat& base, double dx, double dy, double gain = 1, double offset = 0,
+                double sigma = 0, int seed = 0) {
+  cv::Mat out;
+  const cv::Mat M = (cv::Mat_<double>(2, 3) << 1, 0, dx, 0, 1, dy);
+  cv::warpAffine(base, out, M, base.size(), cv::INTER_CUBIC, cv::BORDER_REFLECT);
+  out = out * gain + offset;
+  if (sigma > 0) {
+    cv::Mat noise(out.size(), CV_32FC1);
+    cv::RNG rng(seed);
+    rng.fill(noise, cv::RNG::NORMAL, 0, sigma);
+    out += noise;
+  }
+  cv::Mat u8;
+  out.convertTo(u8, CV_8UC1);
+  return u8;
+}
+}  // namespace
+
+TEST(PatchAnchors, FindsSubPixelShiftUnderGainAndOffset) {
+  const cv::Mat base = texture({200, 160}, 1);
+  PatchAnchorOptions o;
+  PatchAnchors anchors(o);
+  const cv::Point2f p(100.3f, 80.6f);
+  ASSERT_TRUE(anchors.anchor(7, shifted(base, 0, 0), p));
+  const double dx = 0.37, dy = -0.62;
+  const cv::Mat next = shifted(base, dx, dy, 1.3, -20);
+  // Start where a drifted KLT would have put it.
+  cv::Point2f q(p.x + dx + 0.55, p.y + dy - 0.35);
+  ASSERT_TRUE(anchors.refine(7, next, &q));
+  EXPECT_NEAR(q.x, p.x + dx, 0.03);
+  EXPECT_NEAR(q.y, p.y + dy, 0.03);
+}
+
+TEST(PatchAnchors, RefusesLargeShiftsOtherPatchesAndTheBorder) {
+  const cv::Mat base = texture({200, 160}, 2);
+  PatchAnchorOptions o;
+  o.max_shift_px = 1.0;
+  PatchAnchors anchors(o);
+  const cv::Point2f p(90, 70);
+  ASSERT_TRUE(anchors.anchor(1, shifted(base, 0, 0), p));
+  // The true position is 2.5 px from the start: the alignment may find it, but the move is
+  // too large to be taken.
+  const cv::Mat next = shifted(base, 2.5, 0);
+  cv::Point2f q = p;
+  EXPECT_FALSE(anchors.refine(1, next, &q));
+  EXPECT_EQ(q, p);
+  // Unrelated texture: no correlation.
+  cv::Point2f r = p;
+  EXPECT_FALSE(anchors.refine(1, shifted(texture({200, 160}, 3), 0, 0), &r));
+  EXPECT_EQ(r, p);
+  // No anchor for this id; and no anchor where the patch leaves the image.
+  EXPECT_FALSE(anchors.refine(2, next, &q));
+  EXPECT_FALSE(anchors.anchor(3, next, {3, 70}));
+  EXPECT_FALSE(anchors.anchor(3, next, {90, 155}));
+  EXPECT_EQ(anchors.size(), 1u);
+}
+
+TEST(PatchAnchors, ReanchorsAfterItsAgeAndForgetsLostTracks) {
+  const cv::Mat img = shifted(texture({200, 160}, 4), 0, 0);
+  PatchAnchorOptions o;
+  o.reanchor_frames = 3;
+  PatchAnchors anchors(o);
+  ASSERT_TRUE(anchors.anchor(1, img, {50, 50}));
+  ASSERT_TRUE(anchors.anchor(2, img, {120, 90}));
+  anchors.tick();
+  anchors.tick();
+  EXPECT_FALSE(anchors.dueForReanchor(1));
+  anchors.tick();
+  EXPECT_TRUE(anchors.dueForReanchor(1));
+  ASSERT_TRUE(anchors.anchor(1, img, {50, 50}));
+  EXPECT_FALSE(anchors.dueForReanchor(1));
+  EXPECT_TRUE(anchors.dueForReanchor(2));
+  anchors.keepOnly({2});
+  EXPECT_EQ(anchors.size(), 1u);
+  EXPECT_TRUE(anchors.dueForReanchor(1));  // gone: anchor it again
+}
+
+// The purpose: frame-to-frame KLT on noisy images sums its errors along the track; aligning
+// each position to the first frame's patch keeps it near the truth. A low-contrast texture
+// (grey 100-140) under 3.5 DN of noise, like the rendered scenes' (docs/benchmarks.md).
+TEST(PatchAnchors, KeepsTheErrorOfALongTrackBounded) {
+  const cv::Mat base = texture({320, 240}, 5, 100, 140);
+  const int frames = 60;
+  std::vector<cv::Point2f> start;
+  for (int y = 50; y <= 190; y += 35)
+    for (int x = 60; x <= 200; x += 35) start.emplace_back(x + 0.3f, y + 0.7f);
+  PatchAnchorOptions o;
+  o.reanchor_frames = 0;  // one patch for the whole track
+  PatchAnchors anchors(o);
+  cv::Mat prev = shifted(base, 0, 0, 1, 0, 3.5, 100);
+  for (std::size_t i = 0; i < start.size(); ++i)
+    ASSERT_TRUE(anchors.anchor(static_cast<int>(i), prev, start[i]));
+  std::vector<cv::Point2f> klt = start, refined = start;
+  for (int k = 1; k <= frames; ++k) {
+    const double dx = 0.43 * k, dy = 0.21 * k;
+    const cv::Mat next = shifted(base, dx, dy, 1, 0, 3.5, 100 + k);
+    std::vector<cv::Point2f> out;
+    std::vector<uchar> status;
+    cv::calcOpticalFlowPyrLK(prev, next, klt, out, status, cv::noArray(), cv::Size(21, 21), 3);
+    klt = out;
+    // The refined track goes on from its own last position, as the tracker's does.
+    cv::calcOpticalFlowPyrLK(prev, next, std::vector<cv::Point2f>(refined), out, status,
+                             cv::noArray(), cv::Size(21, 21), 3);
+    refined = out;
+    for (std::size_t i = 0; i < refined.size(); ++i)
+      anchors.refine(static_cast<int>(i), next, &refined[i]);
+    prev = next;
+  }
+  auto rms = [&](const std::vector<cv::Point2f>& pts) {
+    double s = 0;
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+      const double ex = pts[i].x - (start[i].x + 0.43 * frames);
+      const double ey = pts[i].y - (start[i].y + 0.21 * frames);
+      s += ex * ex + ey * ey;
+    }
+    return std::sqrt(s / pts.size());
+  };
+  const double e_klt = rms(klt), e_refined = rms(refined);
+  RecordProperty("klt_rms_px", std::to_string(e_klt));
+  RecordProperty("refined_rms_px", std::to_string(e_refined));
+  EXPECT_GT(e_klt, 0.5) << "the sequence should make frame-to-frame KLT drift";
+  EXPECT_LT(e_refined, 0.3) << "KLT alone: " << e_klt;
+  EXPECT_LT(e_refined, 0.5 * e_klt);
+}
