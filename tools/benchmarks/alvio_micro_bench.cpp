@@ -137,9 +137,12 @@ BENCHMARK(BM_LineTrackingFlow)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_LineTrackingFlowDetectEveryFrame)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_LineTrackingDescriptor)->Unit(benchmark::kMillisecond);
 
+// Arg 1: with points.anchors (each track aligned to its anchored patch).
 void BM_PointTracking(benchmark::State& state) {
   const FramePair& f = framePair();
-  PointTracker tracker(config().points, CameraModel::create(config().camera));
+  PointTrackerOptions options = config().points;
+  options.anchors.enabled = state.range(0) != 0;
+  PointTracker tracker(options, CameraModel::create(config().camera));
   int64_t t = 0;
   tracker.track(f.a, t);
   bool odd = true;
@@ -151,7 +154,7 @@ void BM_PointTracking(benchmark::State& state) {
   }
   state.counters["points"] = n;
 }
-BENCHMARK(BM_PointTracking)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_PointTracking)->Unit(benchmark::kMillisecond)->Arg(0)->Arg(1)->ArgName("anchors");
 
 // New corners for a frame that still tracks 120: the point tracker's discs around those,
 // 30 wanted. OpenCV's goodFeaturesToTrack against alvio's CornerDetector (the same corners).

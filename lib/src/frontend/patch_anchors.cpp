@@ -63,6 +63,12 @@ bool PatchAnchors::anchor(int id, const cv::Mat& image, const cv::Point2f& p) {
   patch.inv_h01 = -h01 / det;
   patch.inv_h11 = h00 / det;
   patch.norm = static_cast<float>(std::sqrt(ss));
+  for (int k = 0; k < n * n; ++k) {
+    patch.sum_gx += patch.gx[k];
+    patch.sum_gy += patch.gy[k];
+    patch.sum_gx_t += patch.gx[k] * patch.values[k];
+    patch.sum_gy_t += patch.gy[k] * patch.values[k];
+  }
   patches_[id] = std::move(patch);
   return true;
 }
@@ -71,33 +77,43 @@ bool PatchAnchors::refine(int id, const cv::Mat& image, cv::Point2f* p) const {
   const auto it = patches_.find(id);
   if (it == patches_.end()) return false;
   const Patch& t = it->second;
-  const int n = options_.window, count = n * n;
-  thread_local std::vector<float> cur;
-  cur.resize(count);
+  const int n = options_.window, h = n / 2, count = n * n;
   cv::Point2f q = *p;
   bool converged = false;
   double zncc = 0;
   for (int iter = 0; iter < options_.max_iterations; ++iter) {
-    if (!samplePatch(image, q, n, cur.data())) return false;
-    double sum = 0;
-    for (int k = 0; k < count; ++k) sum += cur[k];
-    const float mean = static_cast<float>(sum / count);
-    double ss = 0, cross = 0;
-    for (int k = 0; k < count; ++k) {
-      cur[k] -= mean;
-      ss += cur[k] * cur[k];
-      cross += cur[k] * t.values[k];
+    // One pass over the image patch at q gathers every sum the step needs; the error image
+    // (the patch scaled to the template's contrast, minus the template) is never formed:
+    //   e = gain (I - mean) - T,  sum g e = gain (sum g I - mean sum g) - sum g T.
+    const float x0 = q.x - h, y0 = q.y - h;
+    if (!(x0 >= 0.f && y0 >= 0.f)) return false;  // also NaN
+    const int ix = static_cast<int>(x0), iy = static_cast<int>(y0);
+    if (ix + n >= image.cols || iy + n >= image.rows) return false;
+    const float fx = x0 - ix, fy = y0 - iy;
+    const float w00 = (1 - fx) * (1 - fy), w01 = fx * (1 - fy), w10 = (1 - fx) * fy, w11 = fx * fy;
+    float s1 = 0, s2 = 0, st = 0, sgx = 0, sgy = 0;
+    for (int r = 0; r < n; ++r) {
+      const uchar* a = image.ptr<uchar>(iy + r) + ix;
+      const uchar* b = image.ptr<uchar>(iy + r + 1) + ix;
+      const float* tv = t.values.data() + r * n;
+      const float* gx = t.gx.data() + r * n;
+      const float* gy = t.gy.data() + r * n;
+      for (int c = 0; c < n; ++c) {
+        const float v = w00 * a[c] + w01 * a[c + 1] + w10 * b[c] + w11 * b[c + 1];
+        s1 += v;
+        s2 += v * v;
+        st += v * tv[c];
+        sgx += v * gx[c];
+        sgy += v * gy[c];
+      }
     }
-    if (ss <= 0) return false;
-    zncc = cross / (std::sqrt(ss) * t.norm);
-    // The image patch scaled to the template's contrast, minus the template.
-    const float gain = static_cast<float>(t.norm / std::sqrt(ss));
-    double bx = 0, by = 0;
-    for (int k = 0; k < count; ++k) {
-      const float e = gain * cur[k] - t.values[k];
-      bx += t.gx[k] * e;
-      by += t.gy[k] * e;
-    }
+    const double mean = s1 / count;
+    const double ss = s2 - count * mean * mean;
+    if (!(ss > 0)) return false;
+    zncc = st / (std::sqrt(ss) * t.norm);  // the template has zero mean
+    const double gain = t.norm / std::sqrt(ss);
+    const double bx = gain * (sgx - mean * t.sum_gx) - t.sum_gx_t;
+    const double by = gain * (sgy - mean * t.sum_gy) - t.sum_gy_t;
     // Inverse compositional: the template's step, applied inverted to the image position.
     const double dx = t.inv_h00 * bx + t.inv_h01 * by;
     const double dy = t.inv_h01 * bx + t.inv_h11 * by;

@@ -45,9 +45,11 @@ class PatchAnchors {
 
  private:
   struct Patch {
-    std::vector<float> values;  ///< zero-mean template, window x window, row-major
-    std::vector<float> gx, gy;  ///< its gradients
-    float norm = 0;             ///< sqrt(sum of values^2)
+    std::vector<float> values;          ///< zero-mean template, window x window, row-major
+    std::vector<float> gx, gy;          ///< its gradients
+    float norm = 0;                     ///< sqrt(sum of values^2)
+    double sum_gx = 0, sum_gy = 0;      ///< sums of the gradients
+    double sum_gx_t = 0, sum_gy_t = 0;  ///< sums of the gradients times the values
     double inv_h00 = 0, inv_h01 = 0, inv_h11 = 0;  ///< inverse of the 2x2 Gauss-Newton matrix
     int age = 0;                                   ///< frames since the patch was taken
   };
