@@ -147,6 +147,7 @@ TEST(Config, PatchAnchorSettingsAreReadAndBadOnesAreRejected) {
   EXPECT_EQ(c.points.anchors.window, 21);
   EXPECT_DOUBLE_EQ(c.points.anchors.max_shift_px, 1.0);
   EXPECT_EQ(c.points.anchors.reanchor_frames, 20);
+  EXPECT_EQ(c.points.anchors.warp, "similarity");
   const std::string dir = test::scratchDir();
   const std::string window =
       test::writeFile(dir + "/window.yaml", eurocYamlReplacing("    window: 21", "    window: 20"));
@@ -158,6 +159,9 @@ TEST(Config, PatchAnchorSettingsAreReadAndBadOnesAreRejected) {
   const std::string zncc =
       test::writeFile(dir + "/zncc.yaml", eurocYamlReplacing("min_zncc: 0.5", "min_zncc: 1.5"));
   expectErrorMentioning([&] { Config::load(zncc); }, {"points.anchors.min_zncc", "[-1, 1]"});
+  const std::string warp =
+      test::writeFile(dir + "/warp.yaml", eurocYamlReplacing("warp: similarity", "warp: affine"));
+  expectErrorMentioning([&] { Config::load(warp); }, {"points.anchors.warp", "affine"});
 }
 
 TEST(Config, NonRotationExtrinsicIsRejected) {

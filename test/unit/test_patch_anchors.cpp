@@ -58,6 +58,33 @@ TEST(PatchAnchors, FindsSubPixelShiftUnderGainAndOffset) {
   EXPECT_NEAR(q.y, p.y + dy, 0.03);
 }
 
+// A patch seen 8 % nearer and turned by 4 degrees since it was anchored, at a corner whose
+// edges lie on one side of the point: the shift alone is pulled towards those edges, the
+// similarity warp is not.
+TEST(PatchAnchors, SimilarityWarpFollowsAPatchSeenNearerAndTurned) {
+  cv::Mat base = texture({200, 160}, 6, 90, 150);
+  base(cv::Rect(100, 80, 100, 80)) += 60;  // a bright quadrant: a corner at (100, 80)
+  const cv::Point2f p(100.0f, 80.0f);
+  const cv::Mat first = shifted(base, 0, 0);
+  cv::Mat turned;
+  const cv::Mat M = cv::getRotationMatrix2D(p, 4.0, 1.08);
+  cv::warpAffine(base, turned, M, base.size(), cv::INTER_CUBIC, cv::BORDER_REFLECT);
+  const cv::Mat next = shifted(turned, 0.3, -0.2);  // the point is now at p + (0.3, -0.2)
+  const cv::Point2f truth(p.x + 0.3f, p.y - 0.2f);
+  double error[2];
+  for (int k = 0; k < 2; ++k) {
+    PatchAnchorOptions o;
+    o.warp = k == 0 ? "translation" : "similarity";
+    PatchAnchors anchors(o);
+    ASSERT_TRUE(anchors.anchor(1, first, p));
+    cv::Point2f q(truth.x - 0.4f, truth.y + 0.3f);
+    ASSERT_TRUE(anchors.refine(1, next, &q)) << o.warp;
+    error[k] = std::hypot(q.x - truth.x, q.y - truth.y);
+  }
+  EXPECT_LT(error[1], 0.1) << "translation only: " << error[0];
+  EXPECT_LT(error[1], 0.25 * error[0]);
+}
+
 TEST(PatchAnchors, RefusesLargeShiftsOtherPatchesAndTheBorder) {
   const cv::Mat base = texture({200, 160}, 2);
   PatchAnchorOptions o;
@@ -105,7 +132,10 @@ TEST(PatchAnchors, ReanchorsAfterItsAgeAndForgetsLostTracks) {
 // The purpose: frame-to-frame KLT on noisy images sums its errors along the track; aligning
 // each position to the first frame's patch keeps it near the truth. A low-contrast texture
 // (grey 100-140) under 3.5 DN of noise, like the rendered scenes' (docs/benchmarks.md).
-TEST(PatchAnchors, KeepsTheErrorOfALongTrackBounded) {
+// Both warps: the similarity's two extra unknowns must not cost the plain shift its precision.
+class LongTrack : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(LongTrack, KeepsTheErrorBounded) {
   const cv::Mat base = texture({320, 240}, 5, 100, 140);
   const int frames = 60;
   std::vector<cv::Point2f> start;
@@ -113,6 +143,7 @@ TEST(PatchAnchors, KeepsTheErrorOfALongTrackBounded) {
     for (int x = 60; x <= 200; x += 35) start.emplace_back(x + 0.3f, y + 0.7f);
   PatchAnchorOptions o;
   o.reanchor_frames = 0;  // one patch for the whole track
+  o.warp = GetParam();
   PatchAnchors anchors(o);
   cv::Mat prev = shifted(base, 0, 0, 1, 0, 3.5, 100);
   for (std::size_t i = 0; i < start.size(); ++i)
@@ -149,3 +180,5 @@ TEST(PatchAnchors, KeepsTheErrorOfALongTrackBounded) {
   EXPECT_LT(e_refined, 0.3) << "KLT alone: " << e_klt;
   EXPECT_LT(e_refined, 0.5 * e_klt);
 }
+
+INSTANTIATE_TEST_SUITE_P(PatchAnchors, LongTrack, ::testing::Values("translation", "similarity"));

@@ -1,5 +1,6 @@
 #include "alvio/frontend/patch_anchors.h"
 
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <unordered_set>
@@ -32,51 +33,59 @@ bool samplePatch(const cv::Mat& image, const cv::Point2f& p, int side, float* ou
 PatchAnchors::PatchAnchors(const PatchAnchorOptions& options) : options_(options) {}
 
 bool PatchAnchors::anchor(int id, const cv::Mat& image, const cv::Point2f& p) {
-  const int n = options_.window, m = n + 2;  // one pixel more each side for the gradients
+  const int n = options_.window, m = n + 2, h = n / 2;  // one more pixel each side: gradients
   std::vector<float> big(m * m);
   if (!samplePatch(image, p, m, big.data())) return false;
   Patch patch;
   patch.values.resize(n * n);
-  patch.gx.resize(n * n);
-  patch.gy.resize(n * n);
+  for (auto& sd : patch.sd) sd.resize(n * n);
   double sum = 0;
   for (int r = 0; r < n; ++r)
     for (int c = 0; c < n; ++c) {
       const int k = r * n + c, b = (r + 1) * m + (c + 1);
+      const float gx = 0.5f * (big[b + 1] - big[b - 1]), gy = 0.5f * (big[b + m] - big[b - m]);
+      const float x = static_cast<float>(c - h), y = static_cast<float>(r - h);
       patch.values[k] = big[b];
-      patch.gx[k] = 0.5f * (big[b + 1] - big[b - 1]);
-      patch.gy[k] = 0.5f * (big[b + m] - big[b - m]);
+      patch.sd[0][k] = gx;
+      patch.sd[1][k] = gy;
+      patch.sd[2][k] = gx * x + gy * y;   // scale
+      patch.sd[3][k] = -gx * y + gy * x;  // rotation
       sum += big[b];
     }
   const float mean = static_cast<float>(sum / (n * n));
-  double h00 = 0, h01 = 0, h11 = 0, ss = 0;
+  double ss = 0;
+  Eigen::Matrix4d H = Eigen::Matrix4d::Zero();
+  patch.sum_sd.setZero();
+  patch.sum_sd_t.setZero();
   for (int k = 0; k < n * n; ++k) {
     patch.values[k] -= mean;
     ss += patch.values[k] * patch.values[k];
-    h00 += patch.gx[k] * patch.gx[k];
-    h01 += patch.gx[k] * patch.gy[k];
-    h11 += patch.gy[k] * patch.gy[k];
+    const Eigen::Vector4d g(patch.sd[0][k], patch.sd[1][k], patch.sd[2][k], patch.sd[3][k]);
+    H.noalias() += g * g.transpose();
+    patch.sum_sd += g;
+    patch.sum_sd_t += g * patch.values[k];
   }
-  const double det = h00 * h11 - h01 * h01;
-  if (!(det > 1e-6 * (h00 + h11) * (h00 + h11)) || ss <= 0) return false;  // no 2D texture
-  patch.inv_h00 = h11 / det;
-  patch.inv_h01 = -h01 / det;
-  patch.inv_h11 = h00 / det;
+  const Eigen::Matrix2d H2 = H.topLeftCorner<2, 2>();
+  const double trace = H2.trace();
+  if (!(H2.determinant() > 1e-6 * trace * trace) || ss <= 0) return false;  // no 2D texture
+  patch.inv_h2 = H2.inverse();
+  // Scale and rotation are weakly seen on plain patches: a small ridge keeps the 4x4 system
+  // invertible there, and barely touches textured ones.
+  H.diagonal().tail<2>() += Eigen::Vector2d::Constant(1e-3 * H(2, 2) + 1e-3 * H(3, 3) + 1e-9);
+  patch.inv_h4 = H.inverse();
   patch.norm = static_cast<float>(std::sqrt(ss));
-  for (int k = 0; k < n * n; ++k) {
-    patch.sum_gx += patch.gx[k];
-    patch.sum_gy += patch.gy[k];
-    patch.sum_gx_t += patch.gx[k] * patch.values[k];
-    patch.sum_gy_t += patch.gy[k] * patch.values[k];
-  }
   patches_[id] = std::move(patch);
   return true;
 }
 
-bool PatchAnchors::refine(int id, const cv::Mat& image, cv::Point2f* p) const {
+bool PatchAnchors::refine(int id, const cv::Mat& image, cv::Point2f* p) {
   const auto it = patches_.find(id);
   if (it == patches_.end()) return false;
-  const Patch& t = it->second;
+  return options_.warp == "similarity" ? refineSimilarity(it->second, image, p)
+                                       : refineShift(it->second, image, p);
+}
+
+bool PatchAnchors::refineShift(Patch& t, const cv::Mat& image, cv::Point2f* p) const {
   const int n = options_.window, h = n / 2, count = n * n;
   cv::Point2f q = *p;
   bool converged = false;
@@ -96,8 +105,8 @@ bool PatchAnchors::refine(int id, const cv::Mat& image, cv::Point2f* p) const {
       const uchar* a = image.ptr<uchar>(iy + r) + ix;
       const uchar* b = image.ptr<uchar>(iy + r + 1) + ix;
       const float* tv = t.values.data() + r * n;
-      const float* gx = t.gx.data() + r * n;
-      const float* gy = t.gy.data() + r * n;
+      const float* gx = t.sd[0].data() + r * n;
+      const float* gy = t.sd[1].data() + r * n;
       for (int c = 0; c < n; ++c) {
         const float v = w00 * a[c] + w01 * a[c + 1] + w10 * b[c] + w11 * b[c + 1];
         s1 += v;
@@ -112,14 +121,13 @@ bool PatchAnchors::refine(int id, const cv::Mat& image, cv::Point2f* p) const {
     if (!(ss > 0)) return false;
     zncc = st / (std::sqrt(ss) * t.norm);  // the template has zero mean
     const double gain = t.norm / std::sqrt(ss);
-    const double bx = gain * (sgx - mean * t.sum_gx) - t.sum_gx_t;
-    const double by = gain * (sgy - mean * t.sum_gy) - t.sum_gy_t;
+    const Eigen::Vector2d g(gain * (sgx - mean * t.sum_sd[0]) - t.sum_sd_t[0],
+                            gain * (sgy - mean * t.sum_sd[1]) - t.sum_sd_t[1]);
     // Inverse compositional: the template's step, applied inverted to the image position.
-    const double dx = t.inv_h00 * bx + t.inv_h01 * by;
-    const double dy = t.inv_h01 * bx + t.inv_h11 * by;
-    q.x -= static_cast<float>(dx);
-    q.y -= static_cast<float>(dy);
-    if (dx * dx + dy * dy < 1e-4) {
+    const Eigen::Vector2d d = t.inv_h2 * g;
+    q.x -= static_cast<float>(d.x());
+    q.y -= static_cast<float>(d.y());
+    if (d.squaredNorm() < 1e-4) {
       converged = true;
       break;
     }
@@ -129,6 +137,86 @@ bool PatchAnchors::refine(int id, const cv::Mat& image, cv::Point2f* p) const {
       sx * sx + sy * sy > options_.max_shift_px * options_.max_shift_px)
     return false;
   *p = q;
+  return true;
+}
+
+bool PatchAnchors::refineSimilarity(Patch& t, const cv::Mat& image, cv::Point2f* p) const {
+  const int n = options_.window, h = n / 2, count = n * n;
+  // Warp of template offset x: A x + q, A = [1+a, -b; b, 1+a]. It starts at KLT's position
+  // with the scale and rotation the track had last.
+  double a = t.a, b = t.b;
+  double qx = p->x, qy = p->y;
+  bool converged = false;
+  double zncc = 0;
+  for (int iter = 0; iter < options_.max_iterations; ++iter) {
+    const double c0 = 1 + a, s0 = b;
+    // The warped window's corners bound it: all must leave room for the bilinear neighbour.
+    bool inside = true;
+    for (int cy : {-h, h})
+      for (int cx : {-h, h}) {
+        const double u = qx + c0 * cx - s0 * cy, v = qy + s0 * cx + c0 * cy;
+        inside &= u >= 0 && v >= 0 && u < image.cols - 1 && v < image.rows - 1;
+      }
+    if (!inside) return false;  // also NaN
+    float s1 = 0, s2 = 0, st = 0;
+    float sg[4] = {0, 0, 0, 0};
+    for (int r = 0; r < n; ++r) {
+      const double y = r - h;
+      // Along a row the sample moves by (c0, s0) per pixel.
+      double u = qx + c0 * (-h) - s0 * y, v = qy + s0 * (-h) + c0 * y;
+      const float* tv = t.values.data() + r * n;
+      const float* g0 = t.sd[0].data() + r * n;
+      const float* g1 = t.sd[1].data() + r * n;
+      const float* g2 = t.sd[2].data() + r * n;
+      const float* g3 = t.sd[3].data() + r * n;
+      for (int c = 0; c < n; ++c, u += c0, v += s0) {
+        const int iu = static_cast<int>(u), iv = static_cast<int>(v);
+        const float fx = static_cast<float>(u - iu), fy = static_cast<float>(v - iv);
+        const uchar* row0 = image.ptr<uchar>(iv) + iu;
+        const uchar* row1 = row0 + image.step[0];
+        const float top = row0[0] + fx * (row0[1] - row0[0]);
+        const float bottom = row1[0] + fx * (row1[1] - row1[0]);
+        const float val = top + fy * (bottom - top);
+        s1 += val;
+        s2 += val * val;
+        st += val * tv[c];
+        sg[0] += val * g0[c];
+        sg[1] += val * g1[c];
+        sg[2] += val * g2[c];
+        sg[3] += val * g3[c];
+      }
+    }
+    const double mean = s1 / count;
+    const double ss = s2 - count * mean * mean;
+    if (!(ss > 0)) return false;
+    zncc = st / (std::sqrt(ss) * t.norm);
+    const double gain = t.norm / std::sqrt(ss);
+    Eigen::Vector4d g;
+    for (int i = 0; i < 4; ++i) g[i] = gain * (sg[i] - mean * t.sum_sd[i]) - t.sum_sd_t[i];
+    const Eigen::Vector4d d = t.inv_h4 * g;
+    // Inverse compositional update: W <- W o W(d)^-1, with W(d) = A_d x + t_d.
+    const Eigen::Matrix2d A = (Eigen::Matrix2d() << c0, -s0, s0, c0).finished();
+    const Eigen::Matrix2d A_d = (Eigen::Matrix2d() << 1 + d[2], -d[3], d[3], 1 + d[2]).finished();
+    const Eigen::Matrix2d A_new = A * A_d.inverse();
+    const Eigen::Vector2d q_new = Eigen::Vector2d(qx, qy) - A_new * d.head<2>();
+    qx = q_new.x();
+    qy = q_new.y();
+    a = A_new(0, 0) - 1;
+    b = A_new(1, 0);
+    if (d.head<2>().squaredNorm() < 1e-4 && d.tail<2>().squaredNorm() < 1e-8) {
+      converged = true;
+      break;
+    }
+  }
+  const double sx = qx - p->x, sy = qy - p->y;
+  // A scale far from 1 is a wrong alignment, not a track seen much nearer.
+  if (!converged || zncc < options_.min_zncc || std::abs(a) > 0.3 || std::abs(b) > 0.3 ||
+      sx * sx + sy * sy > options_.max_shift_px * options_.max_shift_px)
+    return false;
+  p->x = static_cast<float>(qx);
+  p->y = static_cast<float>(qy);
+  t.a = a;
+  t.b = b;
   return true;
 }
 

@@ -4,12 +4,17 @@
 // frames, 1.1 px after 50), and the estimator, which compares every sighting with the
 // track's first one in the window, takes that drift for independent noise. Here each track
 // keeps the patch it had when it was anchored (its detection frame, renewed every
-// `reanchor_frames`) and every new position is aligned to that patch: translation-only
-// inverse-compositional Lucas-Kanade at full resolution, with the patch's brightness and
-// contrast normalised, so that CLAHE's changing tone curve does not pull the alignment.
-// The error along a track is then bounded by the alignment's, not summed over its steps.
+// `reanchor_frames`) and every new position is aligned to that patch: inverse-compositional
+// Lucas-Kanade at full resolution, with the patch's brightness and contrast normalised, so
+// that CLAHE's changing tone curve does not pull the alignment. The warp is a shift, or a
+// similarity (shift, scale, rotation; its last scale and rotation carried from frame to frame)
+// so that a patch seen nearer is not pulled towards its strongest edges. The error along a
+// track is then bounded by the alignment's, not summed over its steps.
 
+#include <Eigen/Core>
+#include <array>
 #include <opencv2/core.hpp>
+#include <string>
 #include <unordered_map>
 #include <vector>
 
@@ -22,6 +27,9 @@ struct PatchAnchorOptions {
   int reanchor_frames = 20;   ///< a track takes a new patch after this many frames (0: never)
   int max_iterations = 10;
   double min_zncc = 0.5;  ///< aligned patches correlating less are not taken
+  /// translation: the patch is only moved; similarity: also scaled and rotated, so that a
+  /// patch seen nearer or turned since it was taken is not pulled towards its strongest edges.
+  std::string warp = "translation";
 };
 
 class PatchAnchors {
@@ -34,7 +42,7 @@ class PatchAnchors {
   /// Aligns track `id`'s anchored patch to `image`, starting at `*p`. Moves `*p` and returns
   /// true when the alignment converged within max_shift_px with at least min_zncc; leaves it
   /// otherwise. A track without an anchor is left as it is.
-  bool refine(int id, const cv::Mat& image, cv::Point2f* p) const;
+  bool refine(int id, const cv::Mat& image, cv::Point2f* p);
   /// One more frame for every track; returns whether `id` is due for a new anchor.
   bool dueForReanchor(int id) const;
   void tick();
@@ -45,14 +53,20 @@ class PatchAnchors {
 
  private:
   struct Patch {
-    std::vector<float> values;          ///< zero-mean template, window x window, row-major
-    std::vector<float> gx, gy;          ///< its gradients
-    float norm = 0;                     ///< sqrt(sum of values^2)
-    double sum_gx = 0, sum_gy = 0;      ///< sums of the gradients
-    double sum_gx_t = 0, sum_gy_t = 0;  ///< sums of the gradients times the values
-    double inv_h00 = 0, inv_h01 = 0, inv_h11 = 0;  ///< inverse of the 2x2 Gauss-Newton matrix
-    int age = 0;                                   ///< frames since the patch was taken
+    std::vector<float> values;  ///< zero-mean template, window x window, row-major
+    /// Steepest-descent images: the template's gradient times the warp's Jacobian, for
+    /// x- and y-shift, then scale and rotation about the patch centre.
+    std::array<std::vector<float>, 4> sd;
+    float norm = 0;                    ///< sqrt(sum of values^2)
+    Eigen::Vector4d sum_sd, sum_sd_t;  ///< sums of sd, and of sd times the values
+    Eigen::Matrix2d inv_h2;            ///< inverse Gauss-Newton matrix of the shift alone
+    Eigen::Matrix4d inv_h4;            ///< of shift, scale and rotation
+    double a = 0, b = 0;               ///< the similarity's last scale-1 and rotation terms
+    int age = 0;                       ///< frames since the patch was taken
   };
+  bool refineShift(Patch& t, const cv::Mat& image, cv::Point2f* p) const;
+  bool refineSimilarity(Patch& t, const cv::Mat& image, cv::Point2f* p) const;
+
   PatchAnchorOptions options_;
   std::unordered_map<int, Patch> patches_;
 };
