@@ -137,11 +137,14 @@ BENCHMARK(BM_LineTrackingFlow)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_LineTrackingFlowDetectEveryFrame)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_LineTrackingDescriptor)->Unit(benchmark::kMillisecond);
 
-// Arg 1: with points.anchors (each track aligned to its anchored patch).
+// Arg 0: KLT alone; 1: with points.anchors' shift (each track aligned to its anchored
+// patch); 2: the shift without the forward-backward check; 3: the similarity warp.
 void BM_PointTracking(benchmark::State& state) {
   const FramePair& f = framePair();
   PointTrackerOptions options = config().points;
   options.anchors.enabled = state.range(0) != 0;
+  options.anchors.warp = state.range(0) == 3 ? "similarity" : "translation";
+  options.forward_backward_check = state.range(0) != 2;
   PointTracker tracker(options, CameraModel::create(config().camera));
   int64_t t = 0;
   tracker.track(f.a, t);
@@ -154,7 +157,7 @@ void BM_PointTracking(benchmark::State& state) {
   }
   state.counters["points"] = n;
 }
-BENCHMARK(BM_PointTracking)->Unit(benchmark::kMillisecond)->Arg(0)->Arg(1)->ArgName("anchors");
+BENCHMARK(BM_PointTracking)->Unit(benchmark::kMillisecond)->DenseRange(0, 3)->ArgName("anchors");
 
 // New corners for a frame that still tracks 120: the point tracker's discs around those,
 // 30 wanted. OpenCV's goodFeaturesToTrack against alvio's CornerDetector (the same corners).
