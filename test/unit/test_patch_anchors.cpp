@@ -53,7 +53,7 @@ TEST(PatchAnchors, FindsSubPixelShiftUnderGainAndOffset) {
   const cv::Mat next = shifted(base, dx, dy, 1.3, -20);
   // Start where a drifted KLT would have put it.
   cv::Point2f q(p.x + dx + 0.55, p.y + dy - 0.35);
-  ASSERT_TRUE(anchors.refine(7, next, &q));
+  ASSERT_EQ(anchors.refine(7, next, &q), Alignment::kAligned);
   EXPECT_NEAR(q.x, p.x + dx, 0.03);
   EXPECT_NEAR(q.y, p.y + dy, 0.03);
 }
@@ -78,11 +78,53 @@ TEST(PatchAnchors, SimilarityWarpFollowsAPatchSeenNearerAndTurned) {
     PatchAnchors anchors(o);
     ASSERT_TRUE(anchors.anchor(1, first, p));
     cv::Point2f q(truth.x - 0.4f, truth.y + 0.3f);
-    ASSERT_TRUE(anchors.refine(1, next, &q)) << o.warp;
+    ASSERT_EQ(anchors.refine(1, next, &q), Alignment::kAligned) << o.warp;
     error[k] = std::hypot(q.x - truth.x, q.y - truth.y);
   }
   EXPECT_LT(error[1], 0.1) << "translation only: " << error[0];
   EXPECT_LT(error[1], 0.25 * error[0]);
+}
+
+// A corner on an occluding edge is no 3D point: the background slides behind it, its patch
+// stops matching, and the alignment says so (end_mismatched ends such tracks). A point on the
+// moving surface itself keeps aligning.
+TEST(PatchAnchors, ACornerOverASlidingBackgroundStopsMatching) {
+  const cv::Mat background = texture({320, 200}, 7, 60, 200);
+  const cv::Mat box = texture({320, 200}, 8, 60, 200);
+  const cv::Rect box_rect(150, 60, 100, 100);  // its top-left corner starts at (150, 60)
+  auto frame = [&](int k) {
+    // The box moves 0.9 px a frame, the background behind it 0.2 px.
+    cv::Mat img = shifted(background, 0.2 * k, 0);
+    const cv::Mat moved_box = shifted(box, 0.9 * k, 0);
+    cv::Mat mask = cv::Mat::zeros(img.size(), CV_8UC1);
+    const cv::Mat M = (cv::Mat_<double>(2, 3) << 1, 0, 0.9 * k, 0, 1, 0);
+    cv::Mat box_mask = cv::Mat::zeros(img.size(), CV_8UC1);
+    box_mask(box_rect).setTo(255);
+    cv::warpAffine(box_mask, mask, M, img.size(), cv::INTER_NEAREST);
+    moved_box.copyTo(img, mask);
+    return img;
+  };
+  PatchAnchorOptions o;
+  o.warp = "similarity";
+  o.min_zncc = 0.7;
+  PatchAnchors anchors(o);
+  const cv::Point2f corner(150.f, 60.f), inside(200.f, 110.f);
+  const cv::Mat first = frame(0);
+  ASSERT_TRUE(anchors.anchor(1, first, corner));
+  ASSERT_TRUE(anchors.anchor(2, first, inside));
+  int corner_lost_at = -1;
+  for (int k = 1; k <= 20; ++k) {
+    const cv::Mat img = frame(k);
+    cv::Point2f c(corner.x + 0.9f * k, corner.y), i(inside.x + 0.9f * k, inside.y);
+    if (corner_lost_at < 0 && anchors.refine(1, img, &c) == Alignment::kMismatch)
+      corner_lost_at = k;
+    ASSERT_EQ(anchors.refine(2, img, &i), Alignment::kAligned) << "frame " << k;
+    EXPECT_NEAR(i.x, inside.x + 0.9 * k, 0.1);
+  }
+  EXPECT_GT(corner_lost_at, 0) << "the occluding corner kept aligning for 20 frames";
+  EXPECT_GE(corner_lost_at, 2) << "lost before the background had slid at all";
+  RecordProperty("corner_lost_at_frame", corner_lost_at);
+  EXPECT_LE(corner_lost_at, 15);
 }
 
 TEST(PatchAnchors, RefusesLargeShiftsOtherPatchesAndTheBorder) {
@@ -96,14 +138,16 @@ TEST(PatchAnchors, RefusesLargeShiftsOtherPatchesAndTheBorder) {
   // too large to be taken.
   const cv::Mat next = shifted(base, 2.5, 0);
   cv::Point2f q = p;
-  EXPECT_FALSE(anchors.refine(1, next, &q));
+  EXPECT_EQ(anchors.refine(1, next, &q), Alignment::kMismatch);
   EXPECT_EQ(q, p);
   // Unrelated texture: no correlation.
   cv::Point2f r = p;
-  EXPECT_FALSE(anchors.refine(1, shifted(texture({200, 160}, 3), 0, 0), &r));
+  EXPECT_EQ(anchors.refine(1, shifted(texture({200, 160}, 3), 0, 0), &r), Alignment::kMismatch);
   EXPECT_EQ(r, p);
   // No anchor for this id; and no anchor where the patch leaves the image.
-  EXPECT_FALSE(anchors.refine(2, next, &q));
+  EXPECT_EQ(anchors.refine(2, next, &q), Alignment::kNoAnchor);
+  cv::Point2f edge(4, 70);
+  EXPECT_EQ(anchors.refine(1, next, &edge), Alignment::kOutside);
   EXPECT_FALSE(anchors.anchor(3, next, {3, 70}));
   EXPECT_FALSE(anchors.anchor(3, next, {90, 155}));
   EXPECT_EQ(anchors.size(), 1u);

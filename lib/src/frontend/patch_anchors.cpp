@@ -82,14 +82,14 @@ bool PatchAnchors::anchor(int id, const cv::Mat& image, const cv::Point2f& p) {
   return true;
 }
 
-bool PatchAnchors::refine(int id, const cv::Mat& image, cv::Point2f* p) {
+Alignment PatchAnchors::refine(int id, const cv::Mat& image, cv::Point2f* p) {
   const auto it = patches_.find(id);
-  if (it == patches_.end()) return false;
+  if (it == patches_.end()) return Alignment::kNoAnchor;
   return options_.warp == "similarity" ? refineSimilarity(it->second, image, p)
                                        : refineShift(it->second, image, p);
 }
 
-bool PatchAnchors::refineShift(Patch& t, const cv::Mat& image, cv::Point2f* p) const {
+Alignment PatchAnchors::refineShift(Patch& t, const cv::Mat& image, cv::Point2f* p) const {
   const int n = options_.window, h = n / 2, count = n * n;
   cv::Point2f q = *p;
   bool converged = false;
@@ -99,9 +99,9 @@ bool PatchAnchors::refineShift(Patch& t, const cv::Mat& image, cv::Point2f* p) c
     // (the patch scaled to the template's contrast, minus the template) is never formed:
     //   e = gain (I - mean) - T,  sum g e = gain (sum g I - mean sum g) - sum g T.
     const float x0 = q.x - h, y0 = q.y - h;
-    if (!(x0 >= 0.f && y0 >= 0.f)) return false;  // also NaN
+    if (!(x0 >= 0.f && y0 >= 0.f)) return Alignment::kOutside;  // also NaN
     const int ix = static_cast<int>(x0), iy = static_cast<int>(y0);
-    if (ix + n >= image.cols || iy + n >= image.rows) return false;
+    if (ix + n >= image.cols || iy + n >= image.rows) return Alignment::kOutside;
     const float fx = x0 - ix, fy = y0 - iy;
     const float w00 = (1 - fx) * (1 - fy), w01 = fx * (1 - fy), w10 = (1 - fx) * fy, w11 = fx * fy;
     float s1 = 0, s2 = 0, st = 0, sgx = 0, sgy = 0;
@@ -122,7 +122,7 @@ bool PatchAnchors::refineShift(Patch& t, const cv::Mat& image, cv::Point2f* p) c
     }
     const double mean = s1 / count;
     const double ss = s2 - count * mean * mean;
-    if (!(ss > 0)) return false;
+    if (!(ss > 0)) return Alignment::kMismatch;
     zncc = st / (std::sqrt(ss) * t.norm);  // the template has zero mean
     const double gain = t.norm / std::sqrt(ss);
     const Eigen::Vector2d g(gain * (sgx - mean * t.sum_sd[0]) - t.sum_sd_t[0],
@@ -139,12 +139,12 @@ bool PatchAnchors::refineShift(Patch& t, const cv::Mat& image, cv::Point2f* p) c
   const float sx = q.x - p->x, sy = q.y - p->y;
   if (!converged || zncc < options_.min_zncc ||
       sx * sx + sy * sy > options_.max_shift_px * options_.max_shift_px)
-    return false;
+    return Alignment::kMismatch;
   *p = q;
-  return true;
+  return Alignment::kAligned;
 }
 
-bool PatchAnchors::refineSimilarity(Patch& t, const cv::Mat& image, cv::Point2f* p) const {
+Alignment PatchAnchors::refineSimilarity(Patch& t, const cv::Mat& image, cv::Point2f* p) const {
   const int n = options_.window, h = n / 2, count = n * n;
   // Warp of template offset x: A x + q, A = [1+a, -b; b, 1+a]. It starts at KLT's position
   // with the scale and rotation the track had last.
@@ -161,7 +161,7 @@ bool PatchAnchors::refineSimilarity(Patch& t, const cv::Mat& image, cv::Point2f*
         const double u = qx + c0 * cx - s0 * cy, v = qy + s0 * cx + c0 * cy;
         inside &= u >= 0 && v >= 0 && u < image.cols - 1.01 && v < image.rows - 1.01;
       }
-    if (!inside) return false;  // also NaN
+    if (!inside) return Alignment::kOutside;  // also NaN
     float s1 = 0, s2 = 0, st = 0;
     float sg[4] = {0, 0, 0, 0};
     const float cf = static_cast<float>(c0), sf = static_cast<float>(s0);
@@ -196,7 +196,7 @@ bool PatchAnchors::refineSimilarity(Patch& t, const cv::Mat& image, cv::Point2f*
     }
     const double mean = s1 / count;
     const double ss = s2 - count * mean * mean;
-    if (!(ss > 0)) return false;
+    if (!(ss > 0)) return Alignment::kMismatch;
     zncc = st / (std::sqrt(ss) * t.norm);
     const double gain = t.norm / std::sqrt(ss);
     Eigen::Vector4d g;
@@ -222,12 +222,12 @@ bool PatchAnchors::refineSimilarity(Patch& t, const cv::Mat& image, cv::Point2f*
   // A scale far from 1 is a wrong alignment, not a track seen much nearer.
   if (!converged || zncc < options_.min_zncc || std::abs(a) > 0.3 || std::abs(b) > 0.3 ||
       sx * sx + sy * sy > options_.max_shift_px * options_.max_shift_px)
-    return false;
+    return Alignment::kMismatch;
   p->x = static_cast<float>(qx);
   p->y = static_cast<float>(qy);
   t.a = a;
   t.b = b;
-  return true;
+  return Alignment::kAligned;
 }
 
 bool PatchAnchors::dueForReanchor(int id) const {

@@ -158,12 +158,22 @@ FeatureFrame PointTracker::track(const cv::Mat& gray, int64_t t_ns, FrameTiming*
 
 void PointTracker::alignToAnchors(const cv::Mat& img) {
   anchors_.tick();
+  std::vector<uchar> keep_track(pts_.size(), 1);
   for (std::size_t i = 0; i < pts_.size(); ++i) {
-    // A patch that no longer aligns (the view changed too much) or has served long enough is
-    // taken again where KLT put the track.
-    if (!anchors_.refine(ids_[i], img, &pts_[i]) || anchors_.dueForReanchor(ids_[i]))
+    const Alignment a = anchors_.refine(ids_[i], img, &pts_[i]);
+    if (a == Alignment::kOutside) continue;  // KLT's position; the patch may fit again later
+    if (a == Alignment::kMismatch && options_.anchors.end_mismatched) {
+      keep_track[i] = 0;
+      continue;
+    }
+    // A patch that no longer aligns (the view changed too much), or that has served long
+    // enough, is taken again where the track is now.
+    if (a != Alignment::kAligned || anchors_.dueForReanchor(ids_[i]))
       anchors_.anchor(ids_[i], img, pts_[i]);
   }
+  keep(&pts_, keep_track);
+  keep(&ids_, keep_track);
+  keep(&track_counts_, keep_track);
 }
 
 void PointTracker::detectNew(const cv::Mat& img) {

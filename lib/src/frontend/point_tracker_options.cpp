@@ -30,6 +30,7 @@ PointTrackerOptions PointTrackerOptions::load(const YamlReader& yaml, const std:
   an.max_iterations = yaml.getInt(a + "max_iterations", an.max_iterations);
   an.min_zncc = yaml.getDouble(a + "min_zncc", an.min_zncc);
   an.warp = yaml.getString(a + "warp", an.warp);
+  an.end_mismatched = yaml.getBool(a + "end_mismatched", an.end_mismatched);
   if (an.warp != "translation" && an.warp != "similarity")
     throw Error(yaml.where(a + "warp") + " must be translation or similarity, not '" + an.warp +
                 "'");

@@ -20,6 +20,14 @@
 
 namespace alvio {
 
+/// What became of an alignment.
+enum class Alignment {
+  kAligned,   ///< converged within max_shift_px and min_zncc: the position was moved
+  kNoAnchor,  ///< the track has no patch
+  kOutside,   ///< the patch reaches out of the image
+  kMismatch,  ///< no convergence, too far, too little correlation, or an implausible warp
+};
+
 struct PatchAnchorOptions {
   bool enabled = false;
   int window = 21;            ///< patch side (odd), pixels
@@ -30,6 +38,10 @@ struct PatchAnchorOptions {
   /// translation: the patch is only moved; similarity: also scaled and rotated, so that a
   /// patch seen nearer or turned since it was taken is not pulled towards its strongest edges.
   std::string warp = "translation";
+  /// A track whose patch no longer aligns ends, instead of taking a new patch: a corner on
+  /// an occluding edge (the background sliding behind it) is no 3D point, and its patch
+  /// changes while a surface point's only warps.
+  bool end_mismatched = false;
 };
 
 class PatchAnchors {
@@ -39,10 +51,9 @@ class PatchAnchors {
   /// Takes the patch around `p` in the 8-bit `image` as track `id`'s anchor (replacing an
   /// older one). Returns false, and anchors nothing, where the patch leaves the image.
   bool anchor(int id, const cv::Mat& image, const cv::Point2f& p);
-  /// Aligns track `id`'s anchored patch to `image`, starting at `*p`. Moves `*p` and returns
-  /// true when the alignment converged within max_shift_px with at least min_zncc; leaves it
-  /// otherwise. A track without an anchor is left as it is.
-  bool refine(int id, const cv::Mat& image, cv::Point2f* p);
+  /// Aligns track `id`'s anchored patch to `image`, starting at `*p`; moves `*p` only when
+  /// the result is kAligned.
+  Alignment refine(int id, const cv::Mat& image, cv::Point2f* p);
   /// One more frame for every track; returns whether `id` is due for a new anchor.
   bool dueForReanchor(int id) const;
   void tick();
@@ -64,8 +75,8 @@ class PatchAnchors {
     double a = 0, b = 0;               ///< the similarity's last scale-1 and rotation terms
     int age = 0;                       ///< frames since the patch was taken
   };
-  bool refineShift(Patch& t, const cv::Mat& image, cv::Point2f* p) const;
-  bool refineSimilarity(Patch& t, const cv::Mat& image, cv::Point2f* p) const;
+  Alignment refineShift(Patch& t, const cv::Mat& image, cv::Point2f* p) const;
+  Alignment refineSimilarity(Patch& t, const cv::Mat& image, cv::Point2f* p) const;
 
   PatchAnchorOptions options_;
   std::unordered_map<int, Patch> patches_;
