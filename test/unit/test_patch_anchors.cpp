@@ -58,31 +58,51 @@ TEST(PatchAnchors, FindsSubPixelShiftUnderGainAndOffset) {
   EXPECT_NEAR(q.y, p.y + dy, 0.03);
 }
 
-// A patch seen 8 % nearer and turned by 4 degrees since it was anchored, at a corner whose
-// edges lie on one side of the point: the shift alone is pulled towards those edges, the
-// similarity warp is not.
-TEST(PatchAnchors, SimilarityWarpFollowsAPatchSeenNearerAndTurned) {
+// A corner whose edges lie on one side of the point, seen again after the view changed: the
+// shift alone is pulled towards those edges, a warp that models the change is not.
+namespace {
+// Position errors after aligning with each warp (translation, similarity, affine), the patch
+// deformed by the 2x2 matrix L about the point, which then moved by (0.3, -0.2); 99 px where
+// the alignment failed.
+std::vector<double> warpErrors(const cv::Matx22d& L) {
   cv::Mat base = texture({200, 160}, 6, 90, 150);
   base(cv::Rect(100, 80, 100, 80)) += 60;  // a bright quadrant: a corner at (100, 80)
   const cv::Point2f p(100.0f, 80.0f);
   const cv::Mat first = shifted(base, 0, 0);
-  cv::Mat turned;
-  const cv::Mat M = cv::getRotationMatrix2D(p, 4.0, 1.08);
-  cv::warpAffine(base, turned, M, base.size(), cv::INTER_CUBIC, cv::BORDER_REFLECT);
-  const cv::Mat next = shifted(turned, 0.3, -0.2);  // the point is now at p + (0.3, -0.2)
+  const cv::Mat M =
+      (cv::Mat_<double>(2, 3) << L(0, 0), L(0, 1), p.x - L(0, 0) * p.x - L(0, 1) * p.y, L(1, 0),
+       L(1, 1), p.y - L(1, 0) * p.x - L(1, 1) * p.y);
+  cv::Mat deformed;
+  cv::warpAffine(base, deformed, M, base.size(), cv::INTER_CUBIC, cv::BORDER_REFLECT);
+  const cv::Mat next = shifted(deformed, 0.3, -0.2);
   const cv::Point2f truth(p.x + 0.3f, p.y - 0.2f);
-  double error[2];
-  for (int k = 0; k < 2; ++k) {
+  std::vector<double> errors;
+  for (const char* warp : {"translation", "similarity", "affine"}) {
     PatchAnchorOptions o;
-    o.warp = k == 0 ? "translation" : "similarity";
+    o.warp = warp;
     PatchAnchors anchors(o);
-    ASSERT_TRUE(anchors.anchor(1, first, p));
+    EXPECT_TRUE(anchors.anchor(1, first, p));
     cv::Point2f q(truth.x - 0.4f, truth.y + 0.3f);
-    ASSERT_EQ(anchors.refine(1, next, &q), Alignment::kAligned) << o.warp;
-    error[k] = std::hypot(q.x - truth.x, q.y - truth.y);
+    const bool aligned = anchors.refine(1, next, &q) == Alignment::kAligned;
+    errors.push_back(aligned ? std::hypot(q.x - truth.x, q.y - truth.y) : 99.0);
   }
-  EXPECT_LT(error[1], 0.1) << "translation only: " << error[0];
-  EXPECT_LT(error[1], 0.25 * error[0]);
+  return errors;
+}
+}  // namespace
+
+TEST(PatchAnchors, SimilarityWarpFollowsAPatchSeenNearerAndTurned) {
+  const double c = 1.08 * std::cos(4 * CV_PI / 180), s = 1.08 * std::sin(4 * CV_PI / 180);
+  const std::vector<double> e = warpErrors(cv::Matx22d(c, s, -s, c));  // 8 % nearer, 4 deg
+  EXPECT_LT(e[1], 0.1) << "translation only: " << e[0];
+  EXPECT_LT(e[1], 0.25 * e[0]);
+  EXPECT_LT(e[2], 0.1) << "affine";
+}
+
+TEST(PatchAnchors, AffineWarpFollowsASlantedPatch) {
+  // Squeezed to 0.85 vertically and sheared, as the floor ahead is seen from nearer.
+  const std::vector<double> e = warpErrors(cv::Matx22d(1.0, 0.12, 0.0, 0.85));
+  EXPECT_LT(e[2], 0.1) << "translation " << e[0] << ", similarity " << e[1];
+  EXPECT_LT(e[2], 0.5 * e[1]) << "translation " << e[0];
 }
 
 // A corner on an occluding edge is no 3D point: the background slides behind it, its patch
@@ -176,7 +196,7 @@ TEST(PatchAnchors, ReanchorsAfterItsAgeAndForgetsLostTracks) {
 // The purpose: frame-to-frame KLT on noisy images sums its errors along the track; aligning
 // each position to the first frame's patch keeps it near the truth. A low-contrast texture
 // (grey 100-140) under 3.5 DN of noise, like the rendered scenes' (docs/benchmarks.md).
-// Both warps: the similarity's two extra unknowns must not cost the plain shift its precision.
+// Every warp: the extra unknowns must not cost the plain shift its precision.
 class LongTrack : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(LongTrack, KeepsTheErrorBounded) {
@@ -225,4 +245,5 @@ TEST_P(LongTrack, KeepsTheErrorBounded) {
   EXPECT_LT(e_refined, 0.5 * e_klt);
 }
 
-INSTANTIATE_TEST_SUITE_P(PatchAnchors, LongTrack, ::testing::Values("translation", "similarity"));
+INSTANTIATE_TEST_SUITE_P(PatchAnchors, LongTrack,
+                         ::testing::Values("translation", "similarity", "affine"));

@@ -1,6 +1,7 @@
 #include "alvio/frontend/patch_anchors.h"
 
 #include <Eigen/LU>
+#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <unordered_set>
@@ -36,13 +37,21 @@ bool samplePatch(const cv::Mat& image, const cv::Point2f& p, int side, float* ou
 
 PatchAnchors::PatchAnchors(const PatchAnchorOptions& options) : options_(options) {}
 
+int PatchAnchors::warpParameters() const {
+  if (options_.warp == "similarity") return 4;
+  if (options_.warp == "affine") return 6;
+  return 2;
+}
+
 bool PatchAnchors::anchor(int id, const cv::Mat& image, const cv::Point2f& p) {
   const int n = options_.window, m = n + 2, h = n / 2;  // one more pixel each side: gradients
+  const int k_params = warpParameters();
+  const bool affine = k_params == 6;
   std::vector<float> big(m * m);
   if (!samplePatch(image, p, m, big.data())) return false;
   Patch patch;
   patch.values.resize(n * n);
-  for (auto& sd : patch.sd) sd.resize(n * n);
+  for (int i = 0; i < k_params; ++i) patch.sd[i].resize(n * n);
   double sum = 0;
   for (int r = 0; r < n; ++r)
     for (int c = 0; c < n; ++c) {
@@ -52,19 +61,27 @@ bool PatchAnchors::anchor(int id, const cv::Mat& image, const cv::Point2f& p) {
       patch.values[k] = big[b];
       patch.sd[0][k] = gx;
       patch.sd[1][k] = gy;
-      patch.sd[2][k] = gx * x + gy * y;   // scale
-      patch.sd[3][k] = -gx * y + gy * x;  // rotation
+      if (k_params == 4) {
+        patch.sd[2][k] = gx * x + gy * y;   // scale
+        patch.sd[3][k] = -gx * y + gy * x;  // rotation
+      } else if (affine) {                  // A = I + [p2 p3; p4 p5]
+        patch.sd[2][k] = gx * x;
+        patch.sd[3][k] = gx * y;
+        patch.sd[4][k] = gy * x;
+        patch.sd[5][k] = gy * y;
+      }
       sum += big[b];
     }
   const float mean = static_cast<float>(sum / (n * n));
   double ss = 0;
-  Eigen::Matrix4d H = Eigen::Matrix4d::Zero();
+  Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
   patch.sum_sd.setZero();
   patch.sum_sd_t.setZero();
   for (int k = 0; k < n * n; ++k) {
     patch.values[k] -= mean;
     ss += patch.values[k] * patch.values[k];
-    const Eigen::Vector4d g(patch.sd[0][k], patch.sd[1][k], patch.sd[2][k], patch.sd[3][k]);
+    Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
+    for (int i = 0; i < k_params; ++i) g[i] = patch.sd[i][k];
     H.noalias() += g * g.transpose();
     patch.sum_sd += g;
     patch.sum_sd_t += g * patch.values[k];
@@ -73,10 +90,15 @@ bool PatchAnchors::anchor(int id, const cv::Mat& image, const cv::Point2f& p) {
   const double trace = H2.trace();
   if (!(H2.determinant() > 1e-6 * trace * trace) || ss <= 0) return false;  // no 2D texture
   patch.inv_h2 = H2.inverse();
-  // Scale and rotation are weakly seen on plain patches: a small ridge keeps the 4x4 system
-  // invertible there, and barely touches textured ones.
-  H.diagonal().tail<2>() += Eigen::Vector2d::Constant(1e-3 * H(2, 2) + 1e-3 * H(3, 3) + 1e-9);
-  patch.inv_h4 = H.inverse();
+  if (k_params > 2) {
+    // The linear part is weakly seen on plain patches: a small ridge keeps the system
+    // invertible there, and barely touches textured ones.
+    const int l = k_params - 2;
+    const double ridge = 1e-3 * H.diagonal().segment(2, l).sum() / l + 1e-9;
+    H.diagonal().segment(2, l).array() += ridge;
+    patch.inv_h.setZero();
+    patch.inv_h.topLeftCorner(k_params, k_params) = H.topLeftCorner(k_params, k_params).inverse();
+  }
   patch.norm = static_cast<float>(std::sqrt(ss));
   patches_[id] = std::move(patch);
   return true;
@@ -85,8 +107,8 @@ bool PatchAnchors::anchor(int id, const cv::Mat& image, const cv::Point2f& p) {
 Alignment PatchAnchors::refine(int id, const cv::Mat& image, cv::Point2f* p) {
   const auto it = patches_.find(id);
   if (it == patches_.end()) return Alignment::kNoAnchor;
-  return options_.warp == "similarity" ? refineSimilarity(it->second, image, p)
-                                       : refineShift(it->second, image, p);
+  return warpParameters() == 2 ? refineShift(it->second, image, p)
+                               : refineWarp(it->second, image, p);
 }
 
 Alignment PatchAnchors::refineShift(Patch& t, const cv::Mat& image, cv::Point2f* p) const {
@@ -144,89 +166,106 @@ Alignment PatchAnchors::refineShift(Patch& t, const cv::Mat& image, cv::Point2f*
   return Alignment::kAligned;
 }
 
-Alignment PatchAnchors::refineSimilarity(Patch& t, const cv::Mat& image, cv::Point2f* p) const {
+namespace {
+// One pass over the warped patch (x' = A x + q, x the template offset): the sums every step
+// needs, for the first K steepest-descent images.
+template <int K>
+void warpedSums(const cv::Mat& image, const Eigen::Matrix2d& A, double qx, double qy, int n,
+                const float* values, const std::array<std::vector<float>, 6>& sd, float* s1,
+                float* s2, float* st, float* sg) {
+  const int h = n / 2;
+  const float a00 = static_cast<float>(A(0, 0)), a01 = static_cast<float>(A(0, 1));
+  const float a10 = static_cast<float>(A(1, 0)), a11 = static_cast<float>(A(1, 1));
+  const uchar* data = image.data;
+  const std::size_t step = image.step[0];
+  float g[K] = {};
+  float sum = 0, sum2 = 0, cross = 0;
+  for (int r = 0; r < n; ++r) {
+    const float y = static_cast<float>(r - h);
+    // Along a row the sample moves by A's first column per pixel.
+    float u = static_cast<float>(qx) - a00 * h + a01 * y;
+    float v = static_cast<float>(qy) - a10 * h + a11 * y;
+    const int row = r * n;
+    for (int c = 0; c < n; ++c, u += a00, v += a10) {
+      const int iu = static_cast<int>(u), iv = static_cast<int>(v);
+      const float fx = u - iu, fy = v - iv;
+      const uchar* row0 = data + iv * step + iu;
+      const uchar* row1 = row0 + step;
+      const float top = row0[0] + fx * (row0[1] - row0[0]);
+      const float bottom = row1[0] + fx * (row1[1] - row1[0]);
+      const float val = top + fy * (bottom - top);
+      sum += val;
+      sum2 += val * val;
+      cross += val * values[row + c];
+      for (int i = 0; i < K; ++i) g[i] += val * sd[i][row + c];
+    }
+  }
+  *s1 = sum;
+  *s2 = sum2;
+  *st = cross;
+  for (int i = 0; i < K; ++i) sg[i] = g[i];
+}
+
+// The linear part of a warp step d (similarity: scale, rotation; affine: four entries).
+Eigen::Matrix2d linearStep(const Eigen::Matrix<double, 6, 1>& d, int k_params) {
+  if (k_params == 4) return (Eigen::Matrix2d() << 1 + d[2], -d[3], d[3], 1 + d[2]).finished();
+  return (Eigen::Matrix2d() << 1 + d[2], d[3], d[4], 1 + d[5]).finished();
+}
+}  // namespace
+
+Alignment PatchAnchors::refineWarp(Patch& t, const cv::Mat& image, cv::Point2f* p) const {
   const int n = options_.window, h = n / 2, count = n * n;
-  // Warp of template offset x: A x + q, A = [1+a, -b; b, 1+a]. It starts at KLT's position
-  // with the scale and rotation the track had last.
-  double a = t.a, b = t.b;
+  const int k_params = warpParameters();
+  // It starts at KLT's position with the linear part the track had last.
+  Eigen::Matrix2d A = t.A;
   double qx = p->x, qy = p->y;
   bool converged = false;
   double zncc = 0;
   for (int iter = 0; iter < options_.max_iterations; ++iter) {
-    const double c0 = 1 + a, s0 = b;
     // The warped window's corners bound it: all must leave room for the bilinear neighbour.
     bool inside = true;
     for (int cy : {-h, h})
       for (int cx : {-h, h}) {
-        const double u = qx + c0 * cx - s0 * cy, v = qy + s0 * cx + c0 * cy;
+        const double u = qx + A(0, 0) * cx + A(0, 1) * cy, v = qy + A(1, 0) * cx + A(1, 1) * cy;
         inside &= u >= 0 && v >= 0 && u < image.cols - 1.01 && v < image.rows - 1.01;
       }
     if (!inside) return Alignment::kOutside;  // also NaN
-    float s1 = 0, s2 = 0, st = 0;
-    float sg[4] = {0, 0, 0, 0};
-    const float cf = static_cast<float>(c0), sf = static_cast<float>(s0);
-    const uchar* data = image.data;
-    const std::size_t step = image.step[0];
-    for (int r = 0; r < n; ++r) {
-      const float y = static_cast<float>(r - h);
-      // Along a row the sample moves by (c0, s0) per pixel.
-      float u = static_cast<float>(qx) - cf * h - sf * y;
-      float v = static_cast<float>(qy) - sf * h + cf * y;
-      const float* tv = t.values.data() + r * n;
-      const float* g0 = t.sd[0].data() + r * n;
-      const float* g1 = t.sd[1].data() + r * n;
-      const float* g2 = t.sd[2].data() + r * n;
-      const float* g3 = t.sd[3].data() + r * n;
-      for (int c = 0; c < n; ++c, u += cf, v += sf) {
-        const int iu = static_cast<int>(u), iv = static_cast<int>(v);
-        const float fx = u - iu, fy = v - iv;
-        const uchar* row0 = data + iv * step + iu;
-        const uchar* row1 = row0 + step;
-        const float top = row0[0] + fx * (row0[1] - row0[0]);
-        const float bottom = row1[0] + fx * (row1[1] - row1[0]);
-        const float val = top + fy * (bottom - top);
-        s1 += val;
-        s2 += val * val;
-        st += val * tv[c];
-        sg[0] += val * g0[c];
-        sg[1] += val * g1[c];
-        sg[2] += val * g2[c];
-        sg[3] += val * g3[c];
-      }
-    }
+    float s1 = 0, s2 = 0, st = 0, sg[6] = {};
+    if (k_params == 4)
+      warpedSums<4>(image, A, qx, qy, n, t.values.data(), t.sd, &s1, &s2, &st, sg);
+    else
+      warpedSums<6>(image, A, qx, qy, n, t.values.data(), t.sd, &s1, &s2, &st, sg);
     const double mean = s1 / count;
     const double ss = s2 - count * mean * mean;
     if (!(ss > 0)) return Alignment::kMismatch;
     zncc = st / (std::sqrt(ss) * t.norm);
     const double gain = t.norm / std::sqrt(ss);
-    Eigen::Vector4d g;
-    for (int i = 0; i < 4; ++i) g[i] = gain * (sg[i] - mean * t.sum_sd[i]) - t.sum_sd_t[i];
-    const Eigen::Vector4d d = t.inv_h4 * g;
-    // Inverse compositional update: W <- W o W(d)^-1, with W(d) = A_d x + t_d.
-    const Eigen::Matrix2d A = (Eigen::Matrix2d() << c0, -s0, s0, c0).finished();
-    const Eigen::Matrix2d A_d = (Eigen::Matrix2d() << 1 + d[2], -d[3], d[3], 1 + d[2]).finished();
-    const Eigen::Matrix2d A_new = A * A_d.inverse();
+    Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
+    for (int i = 0; i < k_params; ++i) g[i] = gain * (sg[i] - mean * t.sum_sd[i]) - t.sum_sd_t[i];
+    const Eigen::Matrix<double, 6, 1> d = t.inv_h * g;
+    // Inverse compositional update: W <- W o W(d)^-1, with W(d) = A_d x + d_shift.
+    const Eigen::Matrix2d A_new = A * linearStep(d, k_params).inverse();
     const Eigen::Vector2d q_new = Eigen::Vector2d(qx, qy) - A_new * d.head<2>();
     qx = q_new.x();
     qy = q_new.y();
-    a = A_new(0, 0) - 1;
-    b = A_new(1, 0);
-    // Scale and rotation need not settle here: they change slowly, and each frame's
-    // alignment starts from the last one's.
+    A = A_new;
+    // The linear part need not settle here: it changes slowly, and each frame's alignment
+    // starts from the last one's.
     if (d.head<2>().squaredNorm() < kConvergedStep2) {
       converged = true;
       break;
     }
   }
   const double sx = qx - p->x, sy = qy - p->y;
-  // A scale far from 1 is a wrong alignment, not a track seen much nearer.
-  if (!converged || zncc < options_.min_zncc || std::abs(a) > 0.3 || std::abs(b) > 0.3 ||
+  // A warp far from a rigid motion's is a wrong alignment, not a track seen much nearer.
+  const Eigen::JacobiSVD<Eigen::Matrix2d> svd(A);
+  const double s_max = svd.singularValues()[0], s_min = svd.singularValues()[1];
+  if (!converged || zncc < options_.min_zncc || s_max > 1.4 || s_min < 0.7 ||
       sx * sx + sy * sy > options_.max_shift_px * options_.max_shift_px)
     return Alignment::kMismatch;
   p->x = static_cast<float>(qx);
   p->y = static_cast<float>(qy);
-  t.a = a;
-  t.b = b;
+  t.A = A;
   return Alignment::kAligned;
 }
 

@@ -31,9 +31,9 @@ PointTrackerOptions PointTrackerOptions::load(const YamlReader& yaml, const std:
   an.min_zncc = yaml.getDouble(a + "min_zncc", an.min_zncc);
   an.warp = yaml.getString(a + "warp", an.warp);
   an.end_mismatched = yaml.getBool(a + "end_mismatched", an.end_mismatched);
-  if (an.warp != "translation" && an.warp != "similarity")
-    throw Error(yaml.where(a + "warp") + " must be translation or similarity, not '" + an.warp +
-                "'");
+  if (an.warp != "translation" && an.warp != "similarity" && an.warp != "affine")
+    throw Error(yaml.where(a + "warp") + " must be translation, similarity or affine, not '" +
+                an.warp + "'");
   if (an.window < 5 || an.window % 2 == 0)
     throw Error(yaml.where(a + "window") + " must be an odd number >= 5");
   if (an.max_shift_px <= 0) throw Error(yaml.where(a + "max_shift_px") + " must be positive");

@@ -36,7 +36,8 @@ struct PatchAnchorOptions {
   int max_iterations = 10;
   double min_zncc = 0.5;  ///< aligned patches correlating less are not taken
   /// translation: the patch is only moved; similarity: also scaled and rotated, so that a
-  /// patch seen nearer or turned since it was taken is not pulled towards its strongest edges.
+  /// patch seen nearer or turned since it was taken is not pulled towards its strongest edges;
+  /// affine: also sheared and squeezed, as a slanted surface (the floor) is seen from ahead.
   std::string warp = "translation";
   /// A track whose patch no longer aligns ends, instead of taking a new patch: a corner on
   /// an occluding edge (the background sliding behind it) is no 3D point, and its patch
@@ -65,18 +66,20 @@ class PatchAnchors {
  private:
   struct Patch {
     std::vector<float> values;  ///< zero-mean template, window x window, row-major
-    /// Steepest-descent images: the template's gradient times the warp's Jacobian, for
-    /// x- and y-shift, then scale and rotation about the patch centre.
-    std::array<std::vector<float>, 4> sd;
-    float norm = 0;                    ///< sqrt(sum of values^2)
-    Eigen::Vector4d sum_sd, sum_sd_t;  ///< sums of sd, and of sd times the values
-    Eigen::Matrix2d inv_h2;            ///< inverse Gauss-Newton matrix of the shift alone
-    Eigen::Matrix4d inv_h4;            ///< of shift, scale and rotation
-    double a = 0, b = 0;               ///< the similarity's last scale-1 and rotation terms
-    int age = 0;                       ///< frames since the patch was taken
+    /// Steepest-descent images: the template's gradient times the warp's Jacobian, for the
+    /// x- and y-shift, then the linear part's parameters (similarity: scale, rotation;
+    /// affine: its four entries) about the patch centre.
+    std::array<std::vector<float>, 6> sd;
+    float norm = 0;                                   ///< sqrt(sum of values^2)
+    Eigen::Matrix<double, 6, 1> sum_sd, sum_sd_t;     ///< sums of sd, and of sd times the values
+    Eigen::Matrix2d inv_h2;                           ///< inverse Gauss-Newton matrix, shift alone
+    Eigen::Matrix<double, 6, 6> inv_h;                ///< of the whole warp (top-left block)
+    Eigen::Matrix2d A = Eigen::Matrix2d::Identity();  ///< the warp's last linear part
+    int age = 0;                                      ///< frames since the patch was taken
   };
+  int warpParameters() const;  ///< 2, 4 or 6
   Alignment refineShift(Patch& t, const cv::Mat& image, cv::Point2f* p) const;
-  Alignment refineSimilarity(Patch& t, const cv::Mat& image, cv::Point2f* p) const;
+  Alignment refineWarp(Patch& t, const cv::Mat& image, cv::Point2f* p) const;
 
   PatchAnchorOptions options_;
   std::unordered_map<int, Patch> patches_;
