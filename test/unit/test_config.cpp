@@ -159,8 +159,8 @@ TEST(Config, PatchAnchorSettingsAreReadAndBadOnesAreRejected) {
   const std::string zncc =
       test::writeFile(dir + "/zncc.yaml", eurocYamlReplacing("min_zncc: 0.5", "min_zncc: 1.5"));
   expectErrorMentioning([&] { Config::load(zncc); }, {"points.anchors.min_zncc", "[-1, 1]"});
-  const std::string warp =
-      test::writeFile(dir + "/warp.yaml", eurocYamlReplacing("warp: similarity", "warp: projective"));
+  const std::string warp = test::writeFile(
+      dir + "/warp.yaml", eurocYamlReplacing("warp: similarity", "warp: projective"));
   expectErrorMentioning([&] { Config::load(warp); }, {"points.anchors.warp", "projective"});
 }
 
