@@ -154,6 +154,9 @@ TEST(PatchAnchors, RefusesLargeShiftsOtherPatchesAndTheBorder) {
   PatchAnchors anchors(o);
   const cv::Point2f p(90, 70);
   ASSERT_TRUE(anchors.anchor(1, shifted(base, 0, 0), p));
+  // Once aligned, a patch that fails is a mismatch (before, it would be unconfirmed).
+  cv::Point2f confirmed = p;
+  ASSERT_EQ(anchors.refine(1, shifted(base, 0.3, 0), &confirmed), Alignment::kAligned);
   // The true position is 2.5 px from the start: the alignment may find it, but the move is
   // too large to be taken.
   const cv::Mat next = shifted(base, 2.5, 0);
@@ -171,6 +174,28 @@ TEST(PatchAnchors, RefusesLargeShiftsOtherPatchesAndTheBorder) {
   EXPECT_FALSE(anchors.anchor(3, next, {3, 70}));
   EXPECT_FALSE(anchors.anchor(3, next, {90, 155}));
   EXPECT_EQ(anchors.size(), 1u);
+}
+
+TEST(PatchAnchors, APatchOfNoiseIsUnconfirmedNotMismatched) {
+  // A plain wall: the patch's texture is the sensor noise, new in every frame.
+  const cv::Mat wall(160, 200, CV_32FC1, cv::Scalar(128));
+  PatchAnchors anchors(PatchAnchorOptions{});
+  const cv::Point2f p(100, 80);
+  ASSERT_TRUE(anchors.anchor(1, shifted(wall, 0, 0, 1, 0, 4, 1), p));
+  for (int k = 1; k <= 3; ++k) {
+    cv::Point2f q = p;
+    EXPECT_EQ(anchors.refine(1, shifted(wall, 0, 0, 1, 0, 4, 1 + k), &q), Alignment::kUnconfirmed)
+        << "frame " << k;
+    EXPECT_EQ(q, p);
+  }
+  // A textured patch taken again where it failed is unconfirmed too, until it aligns.
+  const cv::Mat base = texture({200, 160}, 4);
+  ASSERT_TRUE(anchors.anchor(1, shifted(base, 0, 0), p));
+  cv::Point2f q = p;
+  EXPECT_EQ(anchors.refine(1, shifted(texture({200, 160}, 5), 0, 0), &q), Alignment::kUnconfirmed);
+  ASSERT_EQ(anchors.refine(1, shifted(base, 0.2, 0.1), &q), Alignment::kAligned);
+  q = p;
+  EXPECT_EQ(anchors.refine(1, shifted(texture({200, 160}, 5), 0, 0), &q), Alignment::kMismatch);
 }
 
 TEST(PatchAnchors, ReanchorsAfterItsAgeAndForgetsLostTracks) {

@@ -107,8 +107,11 @@ bool PatchAnchors::anchor(int id, const cv::Mat& image, const cv::Point2f& p) {
 Alignment PatchAnchors::refine(int id, const cv::Mat& image, cv::Point2f* p) {
   const auto it = patches_.find(id);
   if (it == patches_.end()) return Alignment::kNoAnchor;
-  return warpParameters() == 2 ? refineShift(it->second, image, p)
-                               : refineWarp(it->second, image, p);
+  Patch& t = it->second;
+  const Alignment a = warpParameters() == 2 ? refineShift(t, image, p) : refineWarp(t, image, p);
+  if (a == Alignment::kAligned) t.confirmed = true;
+  if (a == Alignment::kMismatch && !t.confirmed) return Alignment::kUnconfirmed;
+  return a;
 }
 
 Alignment PatchAnchors::refineShift(Patch& t, const cv::Mat& image, cv::Point2f* p) const {

@@ -166,8 +166,9 @@ void PointTracker::alignToAnchors(const cv::Mat& img) {
       keep_track[i] = 0;
       continue;
     }
-    // A patch that no longer aligns (the view changed too much), or that has served long
-    // enough, is taken again where the track is now.
+    // A patch that no longer aligns (the view changed too much), that never did (too little
+    // texture to anchor: the track goes on KLT alone), or that has served long enough, is
+    // taken again where the track is now.
     if (a != Alignment::kAligned || anchors_.dueForReanchor(ids_[i]))
       anchors_.anchor(ids_[i], img, pts_[i]);
   }

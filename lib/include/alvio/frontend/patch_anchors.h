@@ -26,6 +26,10 @@ enum class Alignment {
   kNoAnchor,  ///< the track has no patch
   kOutside,   ///< the patch reaches out of the image
   kMismatch,  ///< no convergence, too far, too little correlation, or an implausible warp
+  /// A mismatch of a patch that has never aligned since it was taken: mostly a corner whose
+  /// texture is near the noise (a plain wall under CLAHE correlates 0.0-0.2 one frame
+  /// later), which tells nothing about the track, unlike a confirmed patch that stops fitting.
+  kUnconfirmed,
 };
 
 struct PatchAnchorOptions {
@@ -39,9 +43,9 @@ struct PatchAnchorOptions {
   /// patch seen nearer or turned since it was taken is not pulled towards its strongest edges;
   /// affine: also sheared and squeezed, as a slanted surface (the floor) is seen from ahead.
   std::string warp = "translation";
-  /// A track whose patch no longer aligns ends, instead of taking a new patch: a corner on
-  /// an occluding edge (the background sliding behind it) is no 3D point, and its patch
-  /// changes while a surface point's only warps.
+  /// A track whose patch no longer aligns (kMismatch) ends, instead of taking a new patch: a
+  /// corner on an occluding edge (the background sliding behind it) is no 3D point, and its
+  /// patch changes while a surface point's only warps. An unconfirmed patch is taken again.
   bool end_mismatched = false;
 };
 
@@ -76,6 +80,7 @@ class PatchAnchors {
     Eigen::Matrix<double, 6, 6> inv_h;                ///< of the whole warp (top-left block)
     Eigen::Matrix2d A = Eigen::Matrix2d::Identity();  ///< the warp's last linear part
     int age = 0;                                      ///< frames since the patch was taken
+    bool confirmed = false;                           ///< it has aligned since it was taken
   };
   int warpParameters() const;  ///< 2, 4 or 6
   Alignment refineShift(Patch& t, const cv::Mat& image, cv::Point2f* p) const;
