@@ -142,10 +142,12 @@ class Run:
             if rows:
                 r["duration_s"] = float(rows[-1]["t"]) - float(rows[0]["t"])
                 # Optimisation as the paper counts it: solve plus marginalisation, per frame.
-                opt = sorted(float(x["optimization_ms"]) + float(x["marginalization_ms"])
-                             for x in rows)
-                r["opt_total_median"] = percentile(opt, 50)
-                r["opt_total_p95"] = percentile(opt, 95)
+                # A run that never initialised has no optimisation columns.
+                if "optimization_ms" in rows[0] and "marginalization_ms" in rows[0]:
+                    opt = sorted(float(x["optimization_ms"]) + float(x["marginalization_ms"])
+                                 for x in rows)
+                    r["opt_total_median"] = percentile(opt, 50)
+                    r["opt_total_p95"] = percentile(opt, 95)
                 # Front ends as per-frame sums: with detect_every > 1 the detection stages
                 # alternate between frames, and a sum of their medians would hide that.
                 for key, stages in FRONT_ENDS.items():
@@ -284,6 +286,10 @@ def run_all(runs, jobs):
         done += 1
         res = r.result()
         ate = f"ATE {res['ate']:.4f} m" if res.get("ate") is not None else f"exit {r.rc}"
+        # An ATE over the poses after a reset can look excellent: say how few they were.
+        if res.get("resets") or (res.get("poses") or 0) < 0.5 * (res.get("frames") or 0):
+            ate += f" ({res.get('resets') or 0} resets, {res.get('poses') or 0} poses of " \
+                   f"{res.get('frames') or 0} frames)"
         seed = f" seed {r.seed}" if r.seed != 1 else ""
         log(f"[{done}/{len(runs)}] {r.seq}{seed} {r.variant}: {ate}, {r.wall_s:.0f} s "
             f"(see {r.out}/run.log)")

@@ -22,11 +22,12 @@ STAGES = ["preprocess", "point_tracking", "point_detection", "line_detection", "
           "optimization", "marginalization"]
 
 
-def write_run_folder(folder, seed, lines=True, ate=0.1234, frames=40):
+def write_run_folder(folder, seed, lines=True, ate=0.1234, frames=40, initialised=True):
     """A run folder as alvio_run writes it, from seeded random numbers. Returns the inputs."""
     rng = np.random.default_rng(seed)
     folder.mkdir(parents=True, exist_ok=True)
-    stages = [s for s in STAGES if lines or not s.startswith("line")]
+    stages = [s for s in STAGES if (lines or not s.startswith("line")) and
+              (initialised or s not in ("optimization", "marginalization"))]
     t = 100.0 + 0.05 * np.arange(frames)
     ms = {s: rng.uniform(0.5, 8.0, frames).round(4) for s in stages}
     # Detection every other frame, as with detect_every = 2.
@@ -162,6 +163,13 @@ class RunResultTest(unittest.TestCase):
         self.assertIn("points_front_end_median", r)
         self.assertNotIn("lines_front_end_median", r)
         self.assertEqual(r["lines_used"], 0)
+
+    def test_run_that_never_initialised_has_no_optimisation_time(self):
+        # Its timing.csv has no optimisation columns (a run that failed to initialise).
+        write_run_folder(self.dir / "run", seed=8, initialised=False)
+        r = self.result(self.dir / "run")
+        self.assertNotIn("opt_total_median", r)
+        self.assertIn("points_front_end_median", r)
 
     def test_failed_run_without_files(self):
         (self.dir / "run").mkdir()
