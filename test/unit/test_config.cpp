@@ -146,8 +146,11 @@ TEST(Config, PatchAnchorSettingsAreReadAndBadOnesAreRejected) {
   const Config c = Config::load(test::sourcePath("config/euroc.yaml"));
   EXPECT_EQ(c.points.anchors.window, 21);
   EXPECT_DOUBLE_EQ(c.points.anchors.max_shift_px, 1.0);
-  EXPECT_EQ(c.points.anchors.reanchor_frames, 20);
-  EXPECT_EQ(c.points.anchors.warp, "similarity");
+  EXPECT_TRUE(c.points.anchors.enabled);
+  EXPECT_EQ(c.points.anchors.reanchor_frames, 0);
+  EXPECT_DOUBLE_EQ(c.points.anchors.min_zncc, 0.7);
+  EXPECT_EQ(c.points.anchors.warp, "affine");
+  EXPECT_TRUE(c.points.anchors.end_mismatched);
   const std::string dir = test::scratchDir();
   const std::string window =
       test::writeFile(dir + "/window.yaml", eurocYamlReplacing("    window: 21", "    window: 20"));
@@ -157,10 +160,10 @@ TEST(Config, PatchAnchorSettingsAreReadAndBadOnesAreRejected) {
   expectErrorMentioning([&] { Config::load(shift); },
                         {"points.anchors.max_shift_px", "must be positive"});
   const std::string zncc =
-      test::writeFile(dir + "/zncc.yaml", eurocYamlReplacing("min_zncc: 0.5", "min_zncc: 1.5"));
+      test::writeFile(dir + "/zncc.yaml", eurocYamlReplacing("min_zncc: 0.7", "min_zncc: 1.5"));
   expectErrorMentioning([&] { Config::load(zncc); }, {"points.anchors.min_zncc", "[-1, 1]"});
-  const std::string warp = test::writeFile(
-      dir + "/warp.yaml", eurocYamlReplacing("warp: similarity", "warp: projective"));
+  const std::string warp =
+      test::writeFile(dir + "/warp.yaml", eurocYamlReplacing("warp: affine", "warp: projective"));
   expectErrorMentioning([&] { Config::load(warp); }, {"points.anchors.warp", "projective"});
 }
 

@@ -33,20 +33,20 @@ enum class Alignment {
 };
 
 struct PatchAnchorOptions {
-  bool enabled = false;
+  bool enabled = true;
   int window = 21;            ///< patch side (odd), pixels
   double max_shift_px = 1.0;  ///< refinements moving KLT's position further are not taken
-  int reanchor_frames = 20;   ///< a track takes a new patch after this many frames (0: never)
+  int reanchor_frames = 0;    ///< a track takes a new patch after this many frames (0: never)
   int max_iterations = 10;
-  double min_zncc = 0.5;  ///< aligned patches correlating less are not taken
+  double min_zncc = 0.7;  ///< aligned patches correlating less are not taken
   /// translation: the patch is only moved; similarity: also scaled and rotated, so that a
   /// patch seen nearer or turned since it was taken is not pulled towards its strongest edges;
   /// affine: also sheared and squeezed, as a slanted surface (the floor) is seen from ahead.
-  std::string warp = "translation";
+  std::string warp = "affine";
   /// A track whose patch no longer aligns (kMismatch) ends, instead of taking a new patch: a
   /// corner on an occluding edge (the background sliding behind it) is no 3D point, and its
   /// patch changes while a surface point's only warps. An unconfirmed patch is taken again.
-  bool end_mismatched = false;
+  bool end_mismatched = true;
 };
 
 class PatchAnchors {
