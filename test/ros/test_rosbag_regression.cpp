@@ -23,7 +23,8 @@ namespace {
 // Measured on the first 16 s of the simulated demo sequence (alvio_sim --demo: figure
 // eight in the machine hall; config/euroc.yaml, points and lines): ATE RMSE 0.0125 m
 // (SE(3) alignment) over 242 poses, 20.0 m of path, since initialisation at 40 px parallax
-// (0.0183 m over 229 poses at 80 px). The threshold is 1.3x that.
+// (0.0183 m over 229 poses at 80 px). The threshold is 1.3x that. With the anchored point
+// tracks (points.anchors, on since the twenty-seventh session): 0.0127 m over 237 poses.
 constexpr double kAteThresholdM = 0.0163;
 
 const std::string kData = ALVIO_ROS_TEST_DATA;

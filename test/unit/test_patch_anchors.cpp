@@ -46,6 +46,7 @@ cv::Mat shifted(const cv::Mat& base, double dx, double dy, double gain = 1, doub
 TEST(PatchAnchors, FindsSubPixelShiftUnderGainAndOffset) {
   const cv::Mat base = texture({200, 160}, 1);
   PatchAnchorOptions o;
+  o.warp = "translation";  // the shift alone; the warps' own tests follow
   PatchAnchors anchors(o);
   const cv::Point2f p(100.3f, 80.6f);
   ASSERT_TRUE(anchors.anchor(7, shifted(base, 0, 0), p));
