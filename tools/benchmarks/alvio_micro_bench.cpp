@@ -137,13 +137,14 @@ BENCHMARK(BM_LineTrackingFlow)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_LineTrackingFlowDetectEveryFrame)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_LineTrackingDescriptor)->Unit(benchmark::kMillisecond);
 
-// Arg 0: KLT alone; 1: with points.anchors' shift (each track aligned to its anchored
-// patch); 2: the shift without the forward-backward check; 3: the similarity warp.
+// Arg 0: KLT alone; 1: with points.anchors as configured (each track aligned to its anchored
+// patch; the default warp is affine); 2: that without the forward-backward check; 3: the
+// anchors with the shift alone.
 void BM_PointTracking(benchmark::State& state) {
   const FramePair& f = framePair();
   PointTrackerOptions options = config().points;
   options.anchors.enabled = state.range(0) != 0;
-  options.anchors.warp = state.range(0) == 3 ? "similarity" : "translation";
+  if (state.range(0) == 3) options.anchors.warp = "translation";
   options.forward_backward_check = state.range(0) != 2;
   PointTracker tracker(options, CameraModel::create(config().camera));
   int64_t t = 0;

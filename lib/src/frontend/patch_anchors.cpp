@@ -35,23 +35,23 @@ bool samplePatch(const cv::Mat& image, const cv::Point2f& p, int side, float* ou
 
 }  // namespace
 
-PatchAnchors::PatchAnchors(const PatchAnchorOptions& options) : options_(options) {}
+PatchAnchors::PatchAnchors(const PatchAnchorOptions& options)
+    : options_(options), k_params_(warpParameters(options.warp)) {}
 
-int PatchAnchors::warpParameters() const {
-  if (options_.warp == "similarity") return 4;
-  if (options_.warp == "affine") return 6;
+int PatchAnchors::warpParameters(const std::string& warp) {
+  if (warp == "similarity") return 4;
+  if (warp == "affine") return 6;
   return 2;
 }
 
 bool PatchAnchors::anchor(int id, const cv::Mat& image, const cv::Point2f& p) {
   const int n = options_.window, m = n + 2, h = n / 2;  // one more pixel each side: gradients
-  const int k_params = warpParameters();
-  const bool affine = k_params == 6;
+  const bool affine = k_params_ == 6;
   std::vector<float> big(m * m);
   if (!samplePatch(image, p, m, big.data())) return false;
   Patch patch;
   patch.values.resize(n * n);
-  for (int i = 0; i < k_params; ++i) patch.sd[i].resize(n * n);
+  for (int i = 0; i < k_params_; ++i) patch.sd[i].resize(n * n);
   double sum = 0;
   for (int r = 0; r < n; ++r)
     for (int c = 0; c < n; ++c) {
@@ -61,7 +61,7 @@ bool PatchAnchors::anchor(int id, const cv::Mat& image, const cv::Point2f& p) {
       patch.values[k] = big[b];
       patch.sd[0][k] = gx;
       patch.sd[1][k] = gy;
-      if (k_params == 4) {
+      if (k_params_ == 4) {
         patch.sd[2][k] = gx * x + gy * y;   // scale
         patch.sd[3][k] = -gx * y + gy * x;  // rotation
       } else if (affine) {                  // A = I + [p2 p3; p4 p5]
@@ -81,7 +81,7 @@ bool PatchAnchors::anchor(int id, const cv::Mat& image, const cv::Point2f& p) {
     patch.values[k] -= mean;
     ss += patch.values[k] * patch.values[k];
     Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
-    for (int i = 0; i < k_params; ++i) g[i] = patch.sd[i][k];
+    for (int i = 0; i < k_params_; ++i) g[i] = patch.sd[i][k];
     H.noalias() += g * g.transpose();
     patch.sum_sd += g;
     patch.sum_sd_t += g * patch.values[k];
@@ -90,14 +90,15 @@ bool PatchAnchors::anchor(int id, const cv::Mat& image, const cv::Point2f& p) {
   const double trace = H2.trace();
   if (!(H2.determinant() > 1e-6 * trace * trace) || ss <= 0) return false;  // no 2D texture
   patch.inv_h2 = H2.inverse();
-  if (k_params > 2) {
+  if (k_params_ > 2) {
     // The linear part is weakly seen on plain patches: a small ridge keeps the system
     // invertible there, and barely touches textured ones.
-    const int l = k_params - 2;
+    const int l = k_params_ - 2;
     const double ridge = 1e-3 * H.diagonal().segment(2, l).sum() / l + 1e-9;
     H.diagonal().segment(2, l).array() += ridge;
     patch.inv_h.setZero();
-    patch.inv_h.topLeftCorner(k_params, k_params) = H.topLeftCorner(k_params, k_params).inverse();
+    patch.inv_h.topLeftCorner(k_params_, k_params_) =
+        H.topLeftCorner(k_params_, k_params_).inverse();
   }
   patch.norm = static_cast<float>(std::sqrt(ss));
   patches_[id] = std::move(patch);
@@ -108,7 +109,7 @@ Alignment PatchAnchors::refine(int id, const cv::Mat& image, cv::Point2f* p) {
   const auto it = patches_.find(id);
   if (it == patches_.end()) return Alignment::kNoAnchor;
   Patch& t = it->second;
-  const Alignment a = warpParameters() == 2 ? refineShift(t, image, p) : refineWarp(t, image, p);
+  const Alignment a = k_params_ == 2 ? refineShift(t, image, p) : refineWarp(t, image, p);
   if (a == Alignment::kAligned) t.confirmed = true;
   if (a == Alignment::kMismatch && !t.confirmed) return Alignment::kUnconfirmed;
   return a;
@@ -218,7 +219,6 @@ Eigen::Matrix2d linearStep(const Eigen::Matrix<double, 6, 1>& d, int k_params) {
 
 Alignment PatchAnchors::refineWarp(Patch& t, const cv::Mat& image, cv::Point2f* p) const {
   const int n = options_.window, h = n / 2, count = n * n;
-  const int k_params = warpParameters();
   // It starts at KLT's position with the linear part the track had last.
   Eigen::Matrix2d A = t.A;
   double qx = p->x, qy = p->y;
@@ -234,7 +234,7 @@ Alignment PatchAnchors::refineWarp(Patch& t, const cv::Mat& image, cv::Point2f* 
       }
     if (!inside) return Alignment::kOutside;  // also NaN
     float s1 = 0, s2 = 0, st = 0, sg[6] = {};
-    if (k_params == 4)
+    if (k_params_ == 4)
       warpedSums<4>(image, A, qx, qy, n, t.values.data(), t.sd, &s1, &s2, &st, sg);
     else
       warpedSums<6>(image, A, qx, qy, n, t.values.data(), t.sd, &s1, &s2, &st, sg);
@@ -244,10 +244,10 @@ Alignment PatchAnchors::refineWarp(Patch& t, const cv::Mat& image, cv::Point2f* 
     zncc = st / (std::sqrt(ss) * t.norm);
     const double gain = t.norm / std::sqrt(ss);
     Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
-    for (int i = 0; i < k_params; ++i) g[i] = gain * (sg[i] - mean * t.sum_sd[i]) - t.sum_sd_t[i];
+    for (int i = 0; i < k_params_; ++i) g[i] = gain * (sg[i] - mean * t.sum_sd[i]) - t.sum_sd_t[i];
     const Eigen::Matrix<double, 6, 1> d = t.inv_h * g;
     // Inverse compositional update: W <- W o W(d)^-1, with W(d) = A_d x + d_shift.
-    const Eigen::Matrix2d A_new = A * linearStep(d, k_params).inverse();
+    const Eigen::Matrix2d A_new = A * linearStep(d, k_params_).inverse();
     const Eigen::Vector2d q_new = Eigen::Vector2d(qx, qy) - A_new * d.head<2>();
     qx = q_new.x();
     qy = q_new.y();

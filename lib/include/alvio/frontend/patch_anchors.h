@@ -4,12 +4,12 @@
 // frames, 1.1 px after 50), and the estimator, which compares every sighting with the
 // track's first one in the window, takes that drift for independent noise. Here each track
 // keeps the patch it had when it was anchored (its detection frame, renewed every
-// `reanchor_frames`) and every new position is aligned to that patch: inverse-compositional
-// Lucas-Kanade at full resolution, with the patch's brightness and contrast normalised, so
-// that CLAHE's changing tone curve does not pull the alignment. The warp is a shift, or a
-// similarity (shift, scale, rotation; its last scale and rotation carried from frame to frame)
-// so that a patch seen nearer is not pulled towards its strongest edges. The error along a
-// track is then bounded by the alignment's, not summed over its steps.
+// `reanchor_frames` if set) and every new position is aligned to that patch:
+// inverse-compositional Lucas-Kanade at full resolution, with the patch's brightness and
+// contrast normalised, so that CLAHE's changing tone curve does not pull the alignment. The
+// warp is a shift, a similarity or an affine map (its last linear part carried from frame to
+// frame), so that a patch seen nearer or slanted is not pulled towards its strongest edges.
+// The error along a track is then bounded by the alignment's, not summed over its steps.
 
 #include <Eigen/Core>
 #include <array>
@@ -82,11 +82,13 @@ class PatchAnchors {
     int age = 0;                                      ///< frames since the patch was taken
     bool confirmed = false;                           ///< it has aligned since it was taken
   };
-  int warpParameters() const;  ///< 2, 4 or 6
+  /// The warp's parameter count (2, 4 or 6), from options_.warp once, not per alignment.
+  static int warpParameters(const std::string& warp);
   Alignment refineShift(Patch& t, const cv::Mat& image, cv::Point2f* p) const;
   Alignment refineWarp(Patch& t, const cv::Mat& image, cv::Point2f* p) const;
 
   PatchAnchorOptions options_;
+  int k_params_;
   std::unordered_map<int, Patch> patches_;
 };
 
