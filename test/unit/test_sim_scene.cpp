@@ -84,19 +84,50 @@ TEST(SimScene, BoxHasTwelveEdgesAndClearanceIsSigned) {
   }
 }
 
-TEST(SimScene, EdgesBuriedInsideOtherSolidsAreDropped) {
+TEST(SimScene, EdgesAreCutWhereTheyRunInsideOtherSolids) {
   Scene scene;
   SceneMaterial m;
   m.name = "grey";
   scene.addMaterial(m);
   scene.addBox({0, 0, 0}, Eigen::Matrix3d::Identity(), {2, 2, 2}, 0, scene.addObject("a"));
-  // A thin slab piercing the box: its 4 edges along x run through the box's inside... and
-  // out, so their middles (inside the box) are buried.
+  // A thin slab piercing the box: its 4 edges along x run through the box's inside, so each
+  // leaves two pieces, x in [-3, -1] and [1, 3]; its 8 end edges stay whole.
   scene.addBox({0, 0, 0}, Eigen::Matrix3d::Identity(), {6, 0.2, 0.2}, 0, scene.addObject("b"));
   scene.finalize();
-  EXPECT_EQ(scene.edges().size(), 12u + 8u);
-  for (std::size_t i = 0; i < scene.edges().size(); ++i)
-    EXPECT_EQ(scene.edges()[i].id, static_cast<int>(i));
+  EXPECT_EQ(scene.edges().size(), 12u + 8u + 8u);
+  int pieces = 0;
+  for (std::size_t i = 0; i < scene.edges().size(); ++i) {
+    const SceneEdge& e = scene.edges()[i];
+    EXPECT_EQ(e.id, static_cast<int>(i));
+    if (std::abs(e.a.x() - e.b.x()) < 1e-9) continue;  // not along x
+    if (std::abs(e.a.y()) > 0.5) continue;             // the box's own edges
+    ++pieces;
+    EXPECT_NEAR(std::abs(e.a.x() - e.b.x()), 2.0, 1e-6);
+    EXPECT_NEAR(std::max(std::abs(e.a.x()), std::abs(e.b.x())), 3.0, 1e-6);
+  }
+  EXPECT_EQ(pieces, 8);
+}
+
+TEST(SimScene, ARailKeepsItsEdgesBetweenThePostsThatHoldIt) {
+  // The machine hall's railings: the middle of a rail lies inside a post, which used to drop
+  // the rail's long edges from the truth altogether.
+  Scene scene;
+  SceneMaterial m;
+  m.name = "grey";
+  scene.addMaterial(m);
+  const int obj = scene.addObject("rail");
+  for (double x : {-1.0, 0.0, 1.0})
+    scene.addBox({x, 0, 0.5}, Eigen::Matrix3d::Identity(), {0.05, 0.05, 1.0}, 0, obj);
+  scene.addBox({0, 0, 0.55}, Eigen::Matrix3d::Identity(), {2.0, 0.04, 0.04}, 0, obj);
+  scene.finalize();
+  double rail_length = 0;  // length of the rail's edges along x at z = 0.57
+  for (const SceneEdge& e : scene.edges())
+    if (std::abs(e.a.z() - 0.57) < 1e-9 && std::abs(e.b.z() - 0.57) < 1e-9 &&
+        std::abs(e.a.y() - e.b.y()) < 1e-9 && std::abs(e.a.x() - e.b.x()) > 0.1)
+      rail_length += std::abs(e.a.x() - e.b.x());
+  // Two edges on top, each 2 m minus the inside of three posts (the end posts' outer halves
+  // lie beyond the rail's ends): 2 x (2 - 0.025 - 0.05 - 0.025).
+  EXPECT_NEAR(rail_length, 2 * 1.9, 1e-9);
 }
 
 TEST(SimSceneFile, ParsesObjectsAndReportsErrorsWithObjectAndKey) {

@@ -8,6 +8,7 @@
 #include "alvio/eval/trajectory_interpolation.h"
 #include "alvio/sim/edge_projection.h"
 #include "alvio/sim/procedural_texture.h"
+#include "alvio/sim/sequence_generator.h"
 #include "alvio/sim/sequence_scene.h"
 #include "alvio/sim/surface_distance.h"
 #include "test_support.h"
@@ -58,6 +59,28 @@ TEST(SimTruth, SceneOfASequenceIsCheckedAgainstItsEdges) {
   std::ofstream(dir + "/sim_info.yaml") << "#   scene: plain_room.yaml 0123456789abcdef\n"
                                         << "#   imu: synthetic\n";
   EXPECT_NO_THROW(sim::requireRenderedGroundTruth(dir));
+}
+
+TEST(SimTruth, StaleEdgesOfASequenceAreRewrittenFromItsScene) {
+  const std::string dir = test::scratchDir();
+  const sim::SceneFile room = sim::loadSceneFile("plain_room");
+  // Edges as an older simulator may have written them (here: none at all).
+  std::ofstream(dir + "/scene_edges.csv") << "#id,ax,ay,az,bx,by,bz,object\n";
+  std::ofstream(dir + "/sim_info.yaml")
+      << "#   scene: plain_room.yaml " << sim::fileHash(sim::resolveScenePath("plain_room.yaml"))
+      << "\n";
+  EXPECT_THROW(sim::loadSequenceScene(dir), Error);
+  EXPECT_TRUE(sim::refreshSceneEdges(dir));
+  EXPECT_EQ(sim::loadSequenceScene(dir).scene.edges().size(), room.scene.edges().size());
+  EXPECT_FALSE(sim::refreshSceneEdges(dir));  // now current: left alone
+  // Rendered from another version of the scene file: the images may differ, refuse.
+  std::ofstream(dir + "/sim_info.yaml") << "#   scene: plain_room.yaml 0123456789abcdef\n";
+  try {
+    sim::refreshSceneEdges(dir);
+    ADD_FAILURE() << "a scene file edited since rendering was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("0123456789abcdef"), std::string::npos) << e.what();
+  }
 }
 
 TEST(SimTruth, PoseInterpolation) {

@@ -8,6 +8,7 @@
 #include "alvio/common/error.h"
 #include "alvio/common/logging.h"
 #include "alvio/io/trajectory_io.h"
+#include "alvio/sim/sequence_scene.h"
 
 namespace alvio::sim {
 namespace fs = std::filesystem;
@@ -93,6 +94,8 @@ std::vector<BenchmarkBuildResult> buildBenchmark(const std::string& dir,
     BenchmarkBuildResult r;
     r.name = s.name;
     if (!force && benchmarkSequenceIsCurrent(dir, s)) {
+      if (refreshSceneEdges((fs::path(dir) / s.name).string()))
+        logInfo(s.name, ": scene_edges.csv rewritten with this simulator's edge truth");
       logInfo(s.name, ": up to date, kept");
       results.push_back(r);
       continue;

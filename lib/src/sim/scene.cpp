@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
+#include <utility>
+#include <vector>
 
 #include "alvio/common/error.h"
 
@@ -113,20 +116,79 @@ double quadDistance(const SceneQuad& q, const Eigen::Vector3d& p) {
   const Eigen::Vector3d closest = q.origin + q.edge_u * (a / lu) + q.edge_v * (b / lv);
   return (p - closest).norm();
 }
+
+// The slab test in the box's frame: the interval of t in [0, 1] where a + t (b - a) lies
+// inside the box grown by `grow` (negative: shrunk), if any.
+std::optional<std::pair<double, double>> slabInterval(const SceneSolid& s, const Eigen::Vector3d& a,
+                                                      const Eigen::Vector3d& b, double grow) {
+  const Eigen::Vector3d o = s.R.transpose() * (a - s.center);
+  const Eigen::Vector3d d = s.R.transpose() * (b - a);
+  double t0 = 0.0, t1 = 1.0;
+  for (int i = 0; i < 3; ++i) {
+    const double h = s.half_size[i] + grow;
+    if (h <= 0) return std::nullopt;
+    if (std::abs(d[i]) < 1e-12) {
+      if (std::abs(o[i]) >= h) return std::nullopt;
+      continue;
+    }
+    double lo = (-h - o[i]) / d[i], hi = (h - o[i]) / d[i];
+    if (lo > hi) std::swap(lo, hi);
+    t0 = std::max(t0, lo);
+    t1 = std::min(t1, hi);
+    if (t0 >= t1) return std::nullopt;
+  }
+  return std::make_pair(t0, t1);
+}
+
+// Where the edge a -> b runs inside the box: deeper than `margin` somewhere (an edge on the
+// box's face is not inside it), then cut at the box's true faces.
+std::optional<std::pair<double, double>> insideInterval(const SceneSolid& s,
+                                                        const Eigen::Vector3d& a,
+                                                        const Eigen::Vector3d& b, double margin) {
+  if (!slabInterval(s, a, b, -margin)) return std::nullopt;
+  return slabInterval(s, a, b, 0.0);
+}
+
+// `pieces` (sorted, disjoint) minus the interval `cut`.
+std::vector<std::pair<double, double>> subtractInterval(
+    const std::vector<std::pair<double, double>>& pieces, const std::pair<double, double>& cut) {
+  std::vector<std::pair<double, double>> out;
+  for (const auto& [t0, t1] : pieces) {
+    if (cut.second <= t0 || cut.first >= t1) {
+      out.emplace_back(t0, t1);
+      continue;
+    }
+    if (cut.first > t0) out.emplace_back(t0, cut.first);
+    if (cut.second < t1) out.emplace_back(cut.second, t1);
+  }
+  return out;
+}
+
+// Slivers of a clipped edge shorter than this (a few millimetres poking out of a neighbour)
+// are no line anyone could detect.
+constexpr double kMinEdgePieceM = 0.01;
 }  // namespace
 
 void Scene::finalize() {
-  // Edges whose middle is buried inside another solid can never be seen.
+  // The parts of edges inside another solid can never be seen. Clip each edge against every
+  // solid instead of testing its middle alone: a long rail runs through its posts, and the
+  // post that holds its middle must not delete the whole rail from the truth.
   std::vector<SceneEdge> kept;
   for (const SceneEdge& e : edges_) {
-    const Eigen::Vector3d mid = 0.5 * (e.a + e.b);
-    bool buried = false;
-    for (const SceneSolid& s : solids_)
-      if (boxDistance(s, mid) < -1e-3) {
-        buried = true;
-        break;
-      }
-    if (!buried) kept.push_back(e);
+    std::vector<std::pair<double, double>> pieces{{0.0, 1.0}};
+    for (const SceneSolid& s : solids_) {
+      const auto inside = insideInterval(s, e.a, e.b, 1e-3);
+      if (inside) pieces = subtractInterval(pieces, *inside);
+      if (pieces.empty()) break;
+    }
+    const double length = (e.b - e.a).norm();
+    for (const auto& [t0, t1] : pieces) {
+      if ((t1 - t0) * length < kMinEdgePieceM) continue;
+      SceneEdge piece = e;
+      piece.a = e.a + t0 * (e.b - e.a);
+      piece.b = e.a + t1 * (e.b - e.a);
+      kept.push_back(piece);
+    }
   }
   edges_ = std::move(kept);
   for (std::size_t i = 0; i < edges_.size(); ++i) edges_[i].id = static_cast<int>(i);

@@ -115,15 +115,6 @@ std::vector<int64_t> readStamps(const std::string& path) {
   return stamps;
 }
 
-std::string fileHash(const std::string& path) {
-  if (path.empty()) return "-";
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return "missing";
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return hashText(ss.str());
-}
-
 bool startsMoving(const Trajectory& t) {
   for (const StampedPose& p : t) {
     if (p.t > t.front().t + 1.0) break;
@@ -161,6 +152,15 @@ std::string hashText(const std::string& text) {
   std::ostringstream os;
   os << std::hex << std::setw(16) << std::setfill('0') << h;
   return os.str();
+}
+
+std::string fileHash(const std::string& path) {
+  if (path.empty()) return "-";
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return "missing";
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return hashText(ss.str());
 }
 
 std::string describeSequenceInputs(const SequenceOptions& o) {

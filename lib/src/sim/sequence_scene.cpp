@@ -7,6 +7,7 @@
 #include "alvio/common/error.h"
 #include "alvio/sim/edge_projection.h"
 #include "alvio/sim/procedural_texture.h"
+#include "alvio/sim/sequence_generator.h"
 
 namespace alvio::sim {
 
@@ -48,6 +49,24 @@ void requireRenderedGroundTruth(const std::string& sequence_dir) {
                 "images were rendered along; use a sequence with the synthetic IMU");
 }
 
+namespace {
+// Why `recorded` (read from `csv`) is not the edge list of `scene`, or "" when it is.
+std::string edgeMismatch(const std::vector<SceneEdge>& recorded, const Scene& scene,
+                         const std::string& name, const std::string& csv) {
+  const std::vector<SceneEdge>& edges = scene.edges();
+  if (recorded.size() != edges.size())
+    return "scene '" + name + "' has " + std::to_string(edges.size()) + " edges but " + csv + " " +
+           std::to_string(recorded.size());
+  for (std::size_t i = 0; i < edges.size(); ++i) {
+    const bool same = recorded[i].id == edges[i].id && (recorded[i].a - edges[i].a).norm() < 1e-5 &&
+                      (recorded[i].b - edges[i].b).norm() < 1e-5;
+    if (!same)
+      return "scene '" + name + "' edge " + std::to_string(edges[i].id) + " differs from " + csv;
+  }
+  return "";
+}
+}  // namespace
+
 SceneFile loadSequenceScene(const std::string& sequence_dir, const std::string& scene_override) {
   const std::filesystem::path dir(sequence_dir);
   const std::string name = scene_override.empty()
@@ -55,20 +74,32 @@ SceneFile loadSequenceScene(const std::string& sequence_dir, const std::string& 
                                : scene_override;
   SceneFile file = loadSceneFile(name);
   const std::string csv = (dir / "scene_edges.csv").string();
-  const std::vector<SceneEdge> recorded = readSceneEdgesCsv(csv);
-  const std::vector<SceneEdge>& edges = file.scene.edges();
-  if (recorded.size() != edges.size())
-    throw Error("scene '" + name + "' has " + std::to_string(edges.size()) + " edges but " + csv +
-                " " + std::to_string(recorded.size()) +
-                ": not the scene the sequence was rendered in");
-  for (std::size_t i = 0; i < edges.size(); ++i) {
-    const bool same = recorded[i].id == edges[i].id && (recorded[i].a - edges[i].a).norm() < 1e-5 &&
-                      (recorded[i].b - edges[i].b).norm() < 1e-5;
-    if (!same)
-      throw Error("scene '" + name + "' edge " + std::to_string(edges[i].id) + " differs from " +
-                  csv + ": not the scene the sequence was rendered in");
-  }
+  const std::string mismatch = edgeMismatch(readSceneEdgesCsv(csv), file.scene, name, csv);
+  if (!mismatch.empty())
+    throw Error(mismatch +
+                ": not the scene the sequence was rendered in, or edges written by an older "
+                "simulator (`alvio sim --benchmark DIR` refreshes a benchmark set's edges; "
+                "otherwise render the sequence again)");
   return file;
+}
+
+bool refreshSceneEdges(const std::string& sequence_dir) {
+  const std::filesystem::path dir(sequence_dir);
+  const std::string info = (dir / "sim_info.yaml").string();
+  const std::string name = sceneNameFromSimInfo(info);
+  const std::string rendered_hash =
+      headerValue(info, std::regex(R"(^#\s+scene:\s+\S+\s+(\S+))"), "'# scene:' hash");
+  const std::string path = resolveScenePath(name);
+  if (fileHash(path) != rendered_hash)
+    throw Error(info + " was rendered from another version of " + path + " (hash " + rendered_hash +
+                ", now " + fileHash(path) + "): render the sequence again");
+  const SceneFile file = loadSceneFile(path);
+  const std::string csv = (dir / "scene_edges.csv").string();
+  if (std::filesystem::exists(csv) &&
+      edgeMismatch(readSceneEdgesCsv(csv), file.scene, name, csv).empty())
+    return false;
+  writeSceneEdgesCsv(csv, file.scene);
+  return true;
 }
 
 }  // namespace alvio::sim

@@ -95,7 +95,8 @@ class Scene {
   void addBox(const Eigen::Vector3d& center, const Eigen::Matrix3d& R, const Eigen::Vector3d& size,
               int material, int object);
 
-  /// Build the acceleration structure and drop edges buried inside solids. Must be
+  /// Build the acceleration structure and cut the parts of edges buried inside solids
+  /// (an edge through a solid becomes the pieces either side of it). Must be
   /// called after the last add and before any query.
   void finalize();
   bool finalized() const { return !bvh_.empty() || quads_.empty(); }

@@ -67,5 +67,7 @@ std::string describeSequenceInputs(const SequenceOptions& options);
 
 /// 64-bit FNV-1a hash of a text, as 16 hex digits.
 std::string hashText(const std::string& text);
+/// hashText of a file's content: "-" for an empty path, "missing" for a file not readable.
+std::string fileHash(const std::string& path);
 
 }  // namespace alvio::sim

@@ -34,4 +34,10 @@ void requireRenderedGroundTruth(const std::string& sequence_dir);
 SceneFile loadSequenceScene(const std::string& sequence_dir,
                             const std::string& scene_override = "");
 
+/// Rewrite `sequence_dir`/scene_edges.csv from its scene when the simulator now derives other
+/// edges from it (the images do not depend on the edge list, only the truth does). Returns
+/// whether the file changed. Throws alvio::Error when the scene file is not the one the
+/// sequence was rendered from (its hash in sim_info.yaml differs).
+bool refreshSceneEdges(const std::string& sequence_dir);
+
 }  // namespace alvio::sim
