@@ -85,8 +85,8 @@ std::string microDataset() {
 // Every file a run writes, read back with the library that reads it.
 void expectCompleteOutputs(const std::string& out) {
   for (const char* f : {"trajectory.tum", "timing.csv", "events.log", "frame_stats.csv",
-                        "summary.json", "octomap.bt", "lines.csv", "lines.ply", "map.3Dscene",
-                        "alvio.rawlog", "alvio.3Dscene", "alvio.log"})
+                        "states.csv", "summary.json", "octomap.bt", "lines.csv", "lines.ply",
+                        "map.3Dscene", "alvio.rawlog", "alvio.3Dscene", "alvio.log"})
     EXPECT_TRUE(fs::exists(fs::path(out) / f)) << f;
   const auto summary = nlohmann::json::parse(test::readFile(out + "/summary.json"));
   const std::size_t frames = summary["frames"];
@@ -97,7 +97,13 @@ void expectCompleteOutputs(const std::string& out) {
   // timing.csv: a header and a row per processed frame.
   const std::string timing = test::readFile(out + "/timing.csv");
   EXPECT_EQ(static_cast<std::size_t>(std::count(timing.begin(), timing.end(), '\n')), frames + 1);
-  EXPECT_EQ(test::readFile(out + "/trajectory.tum").rfind("# timestamp", 0), 0u);
+  const std::string trajectory = test::readFile(out + "/trajectory.tum");
+  EXPECT_EQ(trajectory.rfind("# timestamp", 0), 0u);
+  // states.csv: velocity and biases, a header and a row per pose of the trajectory.
+  const std::string states = test::readFile(out + "/states.csv");
+  EXPECT_EQ(states.rfind("t,vx,vy,vz,bax,bay,baz,bgx,bgy,bgz\n", 0), 0u);
+  EXPECT_EQ(std::count(states.begin(), states.end(), '\n'),
+            std::count(trajectory.begin(), trajectory.end(), '\n'));
   mrpt::obs::CRawlog rawlog;
   ASSERT_TRUE(expectSavedFilesLoad(out, &rawlog));
   std::size_t imu = 0;
