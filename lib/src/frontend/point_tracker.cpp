@@ -20,6 +20,7 @@ PointTracker::PointTracker(const PointTrackerOptions& options,
 
 void PointTracker::reset() {
   prev_img_.release();
+  prev_pyramid_.clear();
   pts_.clear();
   ids_.clear();
   track_counts_.clear();
@@ -85,19 +86,27 @@ FeatureFrame PointTracker::track(const cv::Mat& gray, int64_t t_ns, FrameTiming*
 
   {
     ScopedStage stage(timing, "point_tracking");
-    if (!prev_img_.empty() && !pts_.empty()) {
+    const cv::Size win(options_.klt_window, options_.klt_window);
+    // The image's pyramid and gradients, built once: the forward pass needs the previous
+    // frame's, the backward pass this frame's, and this frame's serve the next frame again
+    // (calcOpticalFlowPyrLK on plain images would build them four times a frame). Never
+    // reuse the caller's buffer (tryReuseInputImage = false).
+    std::vector<cv::Mat> pyramid;
+    cv::buildOpticalFlowPyramid(img, pyramid, win, options_.klt_levels, true,
+                                cv::BORDER_REFLECT_101, cv::BORDER_CONSTANT, false);
+    if (!prev_pyramid_.empty() && !pts_.empty()) {
       std::vector<cv::Point2f> next;
       std::vector<uchar> status;
-      const cv::Size win(options_.klt_window, options_.klt_window);
       // No error output (cv::noArray()): KLT's residual per point goes unused, and computing it
       // costs about a tenth of the tracking.
-      cv::calcOpticalFlowPyrLK(prev_img_, img, pts_, next, status, cv::noArray(), win,
+      cv::calcOpticalFlowPyrLK(prev_pyramid_, pyramid, pts_, next, status, cv::noArray(), win,
                                options_.klt_levels);
       if (options_.forward_backward_check) {
         std::vector<cv::Point2f> back = pts_;
         std::vector<uchar> back_status;
         cv::calcOpticalFlowPyrLK(
-            img, prev_img_, next, back, back_status, cv::noArray(), win, options_.klt_levels,
+            pyramid, prev_pyramid_, next, back, back_status, cv::noArray(), win,
+            options_.klt_levels,
             cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 30, 0.01),
             cv::OPTFLOW_USE_INITIAL_FLOW);
         for (std::size_t i = 0; i < status.size(); ++i)
@@ -119,6 +128,7 @@ FeatureFrame PointTracker::track(const cv::Mat& gray, int64_t t_ns, FrameTiming*
       ids_.clear();
       track_counts_.clear();
     }
+    prev_pyramid_ = std::move(pyramid);
     for (int& c : track_counts_) ++c;
   }
 

@@ -44,6 +44,7 @@ class PointTracker {
   CornerDetector corners_;
   PatchAnchors anchors_;
   cv::Mat prev_img_;
+  std::vector<cv::Mat> prev_pyramid_;  // with gradients, for KLT
   int64_t prev_t_ns_ = 0;
   std::vector<cv::Point2f> pts_;
   std::vector<int> ids_, track_counts_;
