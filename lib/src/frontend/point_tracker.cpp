@@ -206,7 +206,7 @@ void PointTracker::detectNew(const cv::Mat& img) {
     cv::circle(mask, p, options_.min_distance_px, 0, -1);
   }
   const int wanted = options_.max_features - static_cast<int>(pts.size());
-  if (wanted > 0) {
+  if (wanted >= options_.min_new_features) {
     const std::vector<cv::Point2f> corners =
         corners_.detect(img, wanted, options_.quality_level, options_.min_distance_px, mask);
     for (const auto& c : corners) {

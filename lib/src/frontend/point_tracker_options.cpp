@@ -10,6 +10,7 @@ PointTrackerOptions PointTrackerOptions::load(const YamlReader& yaml, const std:
   const std::string p = prefix + ".";
   o.max_features = yaml.getInt(p + "max_features", o.max_features);
   o.min_distance_px = yaml.getInt(p + "min_distance_px", o.min_distance_px);
+  o.min_new_features = yaml.getInt(p + "min_new_features", o.min_new_features);
   o.quality_level = yaml.getDouble(p + "quality_level", o.quality_level);
   o.ransac_threshold_px = yaml.getDouble(p + "ransac_threshold_px", o.ransac_threshold_px);
   o.equalize = yaml.getBool(p + "equalize", o.equalize);
@@ -48,6 +49,8 @@ PointTrackerOptions PointTrackerOptions::load(const YamlReader& yaml, const std:
   if (o.clahe_tiles < 1) throw Error(yaml.where(p + "clahe_tiles") + " must be at least 1");
   if (o.max_features < 8) throw Error(yaml.where(p + "max_features") + " must be at least 8");
   if (o.min_distance_px < 1) throw Error(yaml.where(p + "min_distance_px") + " must be at least 1");
+  if (o.min_new_features < 1 || o.min_new_features > o.max_features)
+    throw Error(yaml.where(p + "min_new_features") + " must be in [1, max_features]");
   if (o.klt_window < 5 || o.klt_window % 2 == 0)
     throw Error(yaml.where(p + "klt_window") + " must be an odd number >= 5");
   return o;

@@ -10,8 +10,12 @@ namespace alvio {
 class YamlReader;
 
 struct PointTrackerOptions {
-  int max_features = 150;            ///< target number of tracked corners
-  int min_distance_px = 30;          ///< minimum distance between corners
+  int max_features = 150;    ///< target number of tracked corners
+  int min_distance_px = 30;  ///< minimum distance between corners
+  /// Look for new corners only when at least this many of max_features are missing (1: every
+  /// frame, as VINS-Mono does). Long tracks lose a few points a frame, and the search costs
+  /// the same for one corner as for a hundred.
+  int min_new_features = 1;
   double quality_level = 0.01;       ///< Shi-Tomasi quality relative to the best corner
   double ransac_threshold_px = 1.0;  ///< fundamental-matrix RANSAC threshold
   bool equalize = true;              ///< CLAHE before tracking (robust to exposure changes)
