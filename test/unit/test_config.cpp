@@ -141,7 +141,7 @@ TEST(Config, ClaheSettingsAreReadAndNonPositiveOnesAreRejected) {
       test::writeFile(dir + "/tiles.yaml", eurocYamlReplacing("clahe_tiles: 8", "clahe_tiles: 0"));
   expectErrorMentioning([&] { Config::load(tiles); }, {"points.clahe_tiles", "at least 1"});
   const std::string fresh = test::writeFile(
-      dir + "/fresh.yaml", eurocYamlReplacing("min_new_features: 1", "min_new_features: 151"));
+      dir + "/fresh.yaml", eurocYamlReplacing("min_new_features: 20", "min_new_features: 151"));
   expectErrorMentioning([&] { Config::load(fresh); },
                         {"points.min_new_features", "[1, max_features]"});
 }

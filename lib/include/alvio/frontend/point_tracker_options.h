@@ -15,7 +15,7 @@ struct PointTrackerOptions {
   /// Look for new corners only when at least this many of max_features are missing (1: every
   /// frame, as VINS-Mono does). Long tracks lose a few points a frame, and the search costs
   /// the same for one corner as for a hundred.
-  int min_new_features = 1;
+  int min_new_features = 20;
   double quality_level = 0.01;       ///< Shi-Tomasi quality relative to the best corner
   double ransac_threshold_px = 1.0;  ///< fundamental-matrix RANSAC threshold
   bool equalize = true;              ///< CLAHE before tracking (robust to exposure changes)
