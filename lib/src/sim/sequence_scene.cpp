@@ -90,9 +90,10 @@ bool refreshSceneEdges(const std::string& sequence_dir) {
   const std::string rendered_hash =
       headerValue(info, std::regex(R"(^#\s+scene:\s+\S+\s+(\S+))"), "'# scene:' hash");
   const std::string path = resolveScenePath(name);
-  if (fileHash(path) != rendered_hash)
+  const std::string current_hash = fileHash(path);
+  if (current_hash != rendered_hash)
     throw Error(info + " was rendered from another version of " + path + " (hash " + rendered_hash +
-                ", now " + fileHash(path) + "): render the sequence again");
+                ", now " + current_hash + "): render the sequence again");
   const SceneFile file = loadSceneFile(path);
   const std::string csv = (dir / "scene_edges.csv").string();
   if (std::filesystem::exists(csv) &&
