@@ -89,7 +89,8 @@ def program_env(program):
 
 
 class Run:
-    def __init__(self, seq, data, variant, args, out, binary, max_frames, repeat=0, seed=1):
+    def __init__(self, seq, data, variant, args, out, binary, max_frames, repeat=0, seed=1,
+                 opencv_threads=1):
         self.seq, self.variant, self.out, self.repeat, self.seed = seq, variant, out, repeat, seed
         argv = [x.replace("{out}", str(out)) for x in args]  # "{out}": this run's folder
         if "--bin" in argv:
@@ -99,6 +100,8 @@ class Run:
         self.cmd = [binary, "--dataset", str(data), "--out", str(out), "--quiet", "--no-log"] + argv
         if max_frames > 0:
             self.cmd += ["--max-frames", str(max_frames)]
+        if opencv_threads > 0:
+            self.cmd += ["--opencv-threads", str(opencv_threads)]
         self.proc = None
         self.rss_mb = None
         self.wall_s = None
@@ -400,6 +403,10 @@ def main():
     ap.add_argument("--out", default=str(ROOT / "out" / "bench"), help="run folders and tables [%(default)s]")
     ap.add_argument("--jobs", type=int, default=1, help="runs at once [%(default)s]")
     ap.add_argument("--max-frames", type=int, default=-1, help="stop each run after this many images")
+    ap.add_argument("--opencv-threads", type=int, default=1,
+                    help="alvio run's --opencv-threads: 1 keeps each run on one core (issue 10's "
+                         "single-thread figures; trajectories are the same with more); 0 leaves "
+                         "OpenCV's own default, and is needed for builds before the option [%(default)s]")
     ap.add_argument("--repeats", type=int, default=1,
                     help="runs per sequence and variant, each with --perturb's key nudged [%(default)s]")
     ap.add_argument("--perturb", default="estimator.point_sigma_px",
@@ -511,7 +518,7 @@ def main():
 
     # Interleave variants per sequence (seed and repeat) so that load drifts hit all alike.
     runs = [Run(name, d, v, perturbed_args(with_config(name, args), a.perturb, a.perturb_step, k),
-                folder(name, v, k, seed), a.bin, a.max_frames, k, seed)
+                folder(name, v, k, seed), a.bin, a.max_frames, k, seed, a.opencv_threads)
             for name, d, seed in datasets for k in range(a.repeats) for v, args in parsed]
     log(f"{len(runs)} runs ({len(seqs)} sequences"
         f"{f' x {len(seeds)} seeds' if len(seeds) > 1 else ''} x {len(parsed)} variants"

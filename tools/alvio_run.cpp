@@ -6,6 +6,9 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <string>
+
+#include <opencv2/core/utility.hpp>
 
 #include "alvio/common/arg_parser.h"
 #include "alvio/common/error.h"
@@ -41,9 +44,18 @@ int main(int argc, char** argv) {
                   "override configuration keys: key=value[,key=value...], may be repeated "
                   "(e.g. estimator.selection.points=true)");
   args.flag("no-log", "no MRPT logs (rawlog, 3D scene, alvio.log); also config logger.enabled");
+  args.option("opencv-threads",
+              "threads OpenCV may use inside one call (KLT, CLAHE, resizing); 1 keeps the whole "
+              "pipeline on one core [default: OpenCV's own, all cores]");
   try {
     if (!args.parse(argc, argv)) return 0;
     if (args.isSet("verbose")) setLogLevel(LogLevel::kDebug);
+    if (args.isSet("opencv-threads")) {
+      const int threads = args.getInt("opencv-threads");
+      if (threads < 1)
+        throw Error("--opencv-threads must be at least 1, got " + std::to_string(threads));
+      cv::setNumThreads(threads == 1 ? 0 : threads);  // OpenCV's 0 means: no worker threads
+    }
     // The configuration file with the --set overrides laid over it; the reader keeps the
     // file's path, so relative paths in it still resolve next to the file.
     const std::string config_path = args.get("config");

@@ -2,8 +2,10 @@
 # The ROS tests' input, made in OUT (the build tree), reused while still valid:
 #   sim.bag            the first DURATION s of the simulated demo sequence (alvio_euroc_to_bag)
 #   groundtruth.tum    its ground truth
-#   offline/           the offline runner (alvio_run) on sim.bag: the reference of the
-#                      nodelet pipeline; redone whenever the programs were rebuilt
+#   offline/           the offline runner (alvio_run) on sim.bag, OpenCV on one thread: the
+#                      reference of the nodelet pipeline and of the in-process regression run
+#                      (OpenCV's worker threads must not change the result); redone whenever
+#                      the programs were rebuilt
 # The demo sequence is the simulator's (alvio_sim --demo, deterministic): taken from
 # $ALVIO_DEMO_DATA, <repo>/out/demo/sim, <repo>/../data/demo, else rendered with
 # alvio_sim when it is built. Without any of them OUT/UNAVAILABLE says why and the
@@ -44,7 +46,8 @@ newest_build=$(find "$bin/alvio_run" "$bin/.."/libalvio_{core,mapping,logging}.s
   -newer "$out/offline/trajectory.tum" 2>/dev/null | head -1 || true)
 if [[ ! -f $out/offline/trajectory.tum || -n $newest_build ]]; then
   rm -rf "$out/offline"
-  "$bin/alvio_run" --dataset "$out/sim.bag" --out "$out/offline" --quiet --no-log >"$out/offline.txt" 2>&1 ||
+  "$bin/alvio_run" --dataset "$out/sim.bag" --out "$out/offline" --quiet --no-log \
+    --opencv-threads 1 >"$out/offline.txt" 2>&1 ||
     { cat "$out/offline.txt"; exit 1; }
 fi
 echo "test data in $out (from $demo, $duration s)"

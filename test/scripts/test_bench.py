@@ -380,6 +380,8 @@ class MainTest(unittest.TestCase):
             self.assertEqual(argv[argv.index("--out") + 1], str(out / r["sequence"] / r["variant"]))
             self.assertIn("--quiet", argv)
             self.assertEqual("--no-lines" in argv, r["variant"] == "points")
+            # One core per run unless asked otherwise (issue 10's single-thread figures).
+            self.assertEqual(argv[argv.index("--opencv-threads") + 1], "1")
             # The real EuRoC IMU runs with the in-flight noise configuration.
             config = Path(argv[argv.index("--config") + 1]).name
             self.assertEqual(config, "euroc_real.yaml" if r["sequence"] == "sim_B_realimu"
@@ -414,6 +416,13 @@ class MainTest(unittest.TestCase):
             duration = d["t"][-1] - d["t"][0]
             self.assertGreater(r["wall_s"], 0)
             self.assertEqual(row[10], f"{duration / r['wall_s']:.2f}")
+
+    def test_opencv_threads_zero_leaves_the_option_out(self):
+        # Builds from before the option reject it: 0 must not pass it at all.
+        p = self.bench("--sequences", "sim_A", "--variants", "lines", "--opencv-threads", "0")
+        self.assertEqual(p.returncode, 0, p.stderr)
+        argv = json.loads((self.dir / "out" / "sim_A" / "lines" / "argv.json").read_text())
+        self.assertNotIn("--opencv-threads", argv)
 
     def test_failed_run_gives_exit_1(self):
         (self.fake.parent / "fixtures" / "sim_A" / "lines" / "rc").write_text("3")
