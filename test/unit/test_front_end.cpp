@@ -91,6 +91,8 @@ TEST(PointTracker, NewCornersWaitUntilEnoughAreMissing) {
     }
     // The slide exercises both rules: a few lost a frame, then a jump that loses many.
     EXPECT_GE(large_gaps, 1);
-    if (min_new > 1) EXPECT_GE(small_gaps, 1);
+    if (min_new > 1) {
+      EXPECT_GE(small_gaps, 1);
+    }
   }
 }

@@ -19,7 +19,6 @@ PointTracker::PointTracker(const PointTrackerOptions& options,
       anchors_(options.anchors) {}
 
 void PointTracker::reset() {
-  prev_img_.release();
   prev_pyramid_.clear();
   pts_.clear();
   ids_.clear();
@@ -161,7 +160,6 @@ FeatureFrame PointTracker::track(const cv::Mat& gray, int64_t t_ns, FrameTiming*
     prev_xy_.push_back(o.xy);
     prev_ids_.push_back(o.id);
   }
-  prev_img_ = img;
   prev_t_ns_ = t_ns;
   return frame;
 }

@@ -29,8 +29,6 @@ class PointTracker {
                      double mean_intensity = -1);
   /// Forget all tracks (after a reset, or an image-size change).
   void reset();
-  /// The preprocessed (equalised) image of the last frame, shared with the line front end.
-  const cv::Mat& lastImage() const { return prev_img_; }
 
  private:
   void rejectWithFundamental(std::vector<cv::Point2f>* prev, std::vector<cv::Point2f>* cur,
@@ -43,7 +41,6 @@ class PointTracker {
   cv::Ptr<cv::CLAHE> clahe_;
   CornerDetector corners_;
   PatchAnchors anchors_;
-  cv::Mat prev_img_;
   std::vector<cv::Mat> prev_pyramid_;  // with gradients, for KLT
   int64_t prev_t_ns_ = 0;
   std::vector<cv::Point2f> pts_;
