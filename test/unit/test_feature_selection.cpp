@@ -27,6 +27,24 @@ TEST(AdaptiveWeights, AreThePapersFractionsAndSumToOne) {
   EXPECT_DOUBLE_EQ(more.w_p + more.w_l, 1.0);
 }
 
+TEST(TrackMeasure, LengthIsPerFeatureAndCountIsPerFrame) {
+  // 30 features seen 180 times in an 11-frame window: 6 frames each, 16.4 a frame.
+  EXPECT_DOUBLE_EQ(trackMeasure(180, 30, 11, false), 6.0);
+  EXPECT_DOUBLE_EQ(trackMeasure(180, 30, 11, true), 180.0 / 11);
+  EXPECT_DOUBLE_EQ(trackMeasure(0, 0, 11, false), 0.0);  // no features: no division by zero
+}
+
+TEST(FeatureSelectionOptions, TrackMeasureIsLengthOrCountAndNamesTheKeyOtherwise) {
+  auto load = [](const std::string& text) {
+    return FeatureSelectionOptions::load(YamlReader::fromString(text, "test.yaml"), "selection");
+  };
+  EXPECT_FALSE(load("selection: {adaptive_weighting: true}\n").weights_by_count);
+  EXPECT_FALSE(load("selection: {track_measure: length}\n").weights_by_count);
+  EXPECT_TRUE(load("selection: {track_measure: count}\n").weights_by_count);
+  const std::string error = test::errorOf([&] { load("selection: {track_measure: number}\n"); });
+  EXPECT_NE(error.find("selection.track_measure"), std::string::npos) << error;
+}
+
 TEST(ResidualScales, EqualWeightsLeaveResidualsUnscaled) {
   FeatureWeights equal;  // 0.5 / 0.5
   for (bool normalize : {false, true})

@@ -76,9 +76,9 @@ void Estimator::updateWeights() {
     ++stats_.lines_used;
     line_residuals += static_cast<int>(l.observations.size());
   }
-  const double M_p = stats_.points_tracked ? track_p / stats_.points_tracked : 0;
-  const double M_l = stats_.lines_tracked ? track_l / stats_.lines_tracked : 0;
   const FeatureSelectionOptions& o = options_.selection;
+  const double M_p = trackMeasure(track_p, stats_.points_tracked, W_ + 1, o.weights_by_count);
+  const double M_l = trackMeasure(track_l, stats_.lines_tracked, W_ + 1, o.weights_by_count);
   const FeatureWeights w = adaptiveWeights(M_p, M_l, o);
   stats_.w_p = w.w_p;
   stats_.w_l = w.w_l;

@@ -52,6 +52,12 @@ FeatureSelectionOptions FeatureSelectionOptions::load(const YamlReader& yaml,
   o.alpha_similar = yaml.getDouble(p + "alpha_similar", o.alpha_similar);
   o.alpha_less = yaml.getDouble(p + "alpha_less", o.alpha_less);
   o.similar_band = yaml.getDouble(p + "similar_band", o.similar_band);
+  const std::string measure =
+      yaml.getString(p + "track_measure", o.weights_by_count ? "count" : "length");
+  if (measure != "length" && measure != "count")
+    throw Error(yaml.where(p + "track_measure") + " must be length or count, not '" + measure +
+                "'");
+  o.weights_by_count = measure == "count";
   o.normalize_weights = yaml.getBool(p + "normalize_weights", o.normalize_weights);
   const bool costs = o.weights_on == WeightTarget::kCosts;
   const std::string weights_on = yaml.getString(p + "weights_on", costs ? "costs" : "residuals");
@@ -75,6 +81,11 @@ FeatureSelectionOptions FeatureSelectionOptions::load(const YamlReader& yaml,
     throw Error(yaml.where(p + "surfaces_file") +
                 " must name a selection_surfaces.yaml with the selected kinds (alvio analyze)");
   return o;
+}
+
+double trackMeasure(double observations, int features, int frames, bool by_count) {
+  const int divisor = by_count ? frames : features;
+  return divisor > 0 ? observations / divisor : 0.0;
 }
 
 FeatureWeights adaptiveWeights(double M_p, double M_l, const FeatureSelectionOptions& o) {

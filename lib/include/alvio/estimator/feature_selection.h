@@ -42,6 +42,9 @@ struct FeatureSelectionOptions {
   double alpha_similar = 2.2;  ///< about as long
   double alpha_less = 1.0;     ///< shorter
   double similar_band = 0.2;   ///< |M_l - M_p| <= band * max(M_l, M_p) counts as "about as long"
+  /// What M_p and M_l measure: false, each kind's mean track length (observations per feature
+  /// in the window); true, its mean number of tracks (tracked features per frame of the window).
+  bool weights_by_count = false;
   /// Scale the weighted residuals so that points and lines together carry as much
   /// information as unweighted: the weights then move trust between points and lines, not
   /// from the camera to the IMU. Off: the 2w of `weights_on` as it is (equal weights =
@@ -61,6 +64,10 @@ struct FeatureWeights {
   double w_p = 0.5, w_l = 0.5, alpha = 1.0;
   double M_p = 0, M_l = 0;  ///< mean track counts in the window
 };
+
+/// M for one kind of feature: `observations` summed over its `features` in a window of
+/// `frames`. By length, observations per feature; by count, tracked features per frame.
+double trackMeasure(double observations, int features, int frames, bool by_count);
 
 /// The ALVIO weights for mean track counts M_p and M_l.
 FeatureWeights adaptiveWeights(double M_p, double M_l, const FeatureSelectionOptions& options);
