@@ -38,7 +38,7 @@ TEST(FeatureSelectionOptions, TrackMeasureIsLengthOrCountAndNamesTheKeyOtherwise
   auto load = [](const std::string& text) {
     return FeatureSelectionOptions::load(YamlReader::fromString(text, "test.yaml"), "selection");
   };
-  EXPECT_FALSE(load("selection: {adaptive_weighting: true}\n").weights_by_count);
+  EXPECT_TRUE(load("selection: {adaptive_weighting: true}\n").weights_by_count);  // default
   EXPECT_FALSE(load("selection: {track_measure: length}\n").weights_by_count);
   EXPECT_TRUE(load("selection: {track_measure: count}\n").weights_by_count);
   const std::string error = test::errorOf([&] { load("selection: {track_measure: number}\n"); });

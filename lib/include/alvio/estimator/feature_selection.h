@@ -2,10 +2,10 @@
 // Sensitivity-analysis-based feature selection and adaptive weighting (ALVIO,
 // Sec. 3). A fitted surface gives the expected track length of a feature from
 // its image position; features where it is below a level are left out of the
-// optimisation. Points and lines are weighted by how long each kind tracks:
+// optimisation. Points and lines are weighted by how many of each kind are tracked:
 //   w_p = M_p / (a M_l + M_p),  w_l = a M_l / (a M_l + M_p),
 // with a = alpha_more, alpha_similar or alpha_less when lines track more than,
-// about as long as, or less than points.
+// about as much as, or less than points (M by count, or by track length: trackMeasure).
 
 #include <array>
 #include <string>
@@ -38,13 +38,14 @@ struct FeatureSelectionOptions {
   std::string surfaces_file;  ///< selection_surfaces.yaml (alvio analyze); relative to the config
   TrackSurface point_surface, line_surface;  ///< loaded from surfaces_file
   bool adaptive_weighting = true;
-  double alpha_more = 5.0;     ///< lines track longer than points
-  double alpha_similar = 2.2;  ///< about as long
-  double alpha_less = 1.0;     ///< shorter
-  double similar_band = 0.2;   ///< |M_l - M_p| <= band * max(M_l, M_p) counts as "about as long"
-  /// What M_p and M_l measure: false, each kind's mean track length (observations per feature
-  /// in the window); true, its mean number of tracks (tracked features per frame of the window).
-  bool weights_by_count = false;
+  double alpha_more = 5.0;     ///< lines track more than points (M_l > M_p)
+  double alpha_similar = 2.2;  ///< about as much
+  double alpha_less = 1.0;     ///< less
+  double similar_band = 0.2;   ///< |M_l - M_p| <= band * max(M_l, M_p) counts as "about as much"
+  /// What M_p and M_l measure: true, each kind's mean number of tracks (tracked features per
+  /// frame of the window: the paper's "number of tracking", which it says is much larger for
+  /// points); false, its mean track length (observations per feature in the window).
+  bool weights_by_count = true;
   /// Scale the weighted residuals so that points and lines together carry as much
   /// information as unweighted: the weights then move trust between points and lines, not
   /// from the camera to the IMU. Off: the 2w of `weights_on` as it is (equal weights =
