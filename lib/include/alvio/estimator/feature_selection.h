@@ -63,14 +63,14 @@ void loadTrackSurfaces(const std::string& path, TrackSurface* points, TrackSurfa
 
 struct FeatureWeights {
   double w_p = 0.5, w_l = 0.5, alpha = 1.0;
-  double M_p = 0, M_l = 0;  ///< mean track counts in the window
+  double M_p = 0, M_l = 0;  ///< trackMeasure() of the points and lines in the window
 };
 
 /// M for one kind of feature: `observations` summed over its `features` in a window of
 /// `frames`. By length, observations per feature; by count, tracked features per frame.
 double trackMeasure(double observations, int features, int frames, bool by_count);
 
-/// The ALVIO weights for mean track counts M_p and M_l.
+/// The ALVIO weights for the track measures M_p and M_l.
 FeatureWeights adaptiveWeights(double M_p, double M_l, const FeatureSelectionOptions& options);
 
 /// Factors that multiply the point and line residuals for weights `w`, with
