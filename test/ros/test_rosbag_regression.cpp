@@ -3,7 +3,8 @@
 // keep its accuracy: ATE RMSE under a committed threshold. It must also be
 // deterministic: the same poses as alvio_run produced on the same bag (the test
 // data step runs it with --opencv-threads 1, so this in-process run, with OpenCV's worker
-// threads, also shows that they leave the result alone). Input: make_test_data.sh (ctest fixture alvio_ros_data).
+// threads, also shows that they leave the result alone). Input: make_test_data.sh (ctest fixture
+// alvio_ros_data).
 #include <gtest/gtest.h>
 
 #include <filesystem>

@@ -183,6 +183,22 @@ TEST(Config, WrongListSizeIsRejected) {
   expectErrorMentioning([&] { yaml.getDoubles("a", 4); }, {"mem.yaml", "'a'", "4 values"});
 }
 
+TEST(Config, AChoiceOutsideItsWordsNamesThemAll) {
+  const auto yaml = YamlReader::fromString("a: two\nb: tree\n", "mem.yaml");
+  EXPECT_EQ(yaml.getChoice("a", "one", {"one", "two"}), "two");
+  EXPECT_EQ(yaml.getChoice("missing", "one", {"one", "two"}), "one");
+  expectErrorMentioning(
+      [&] {
+        yaml.getChoice("b", "one", {"one", "two", "three"});
+      },
+      {"mem.yaml", "'b'", "must be one, two or three, not 'tree'"});
+  expectErrorMentioning(
+      [&] {
+        yaml.getChoice("b", "one", {"one", "two"});
+      },
+      {"must be one or two, not 'tree'"});
+}
+
 TEST(Config, UnknownKeysAreReported) {
   const std::string dir = test::scratchDir();
   const std::string path = test::writeFile(

@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -166,6 +167,15 @@ std::vector<double> YamlReader::getDoubles(const std::string& key,
                                            const std::vector<double>& fallback) const {
   if (!find(key)) return fallback;
   return getDoubles(key);
+}
+std::string YamlReader::getChoice(const std::string& key, const std::string& fallback,
+                                  const std::vector<std::string>& choices) const {
+  const std::string value = getString(key, fallback);
+  if (std::find(choices.begin(), choices.end(), value) != choices.end()) return value;
+  std::string list;
+  for (std::size_t i = 0; i < choices.size(); ++i)
+    list += (i == 0 ? "" : i + 1 == choices.size() ? " or " : ", ") + choices[i];
+  throw Error(where(key) + " must be " + list + ", not '" + value + "'");
 }
 
 Eigen::Isometry3d YamlReader::getTransform(const std::string& key) const {

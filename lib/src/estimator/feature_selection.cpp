@@ -52,18 +52,12 @@ FeatureSelectionOptions FeatureSelectionOptions::load(const YamlReader& yaml,
   o.alpha_similar = yaml.getDouble(p + "alpha_similar", o.alpha_similar);
   o.alpha_less = yaml.getDouble(p + "alpha_less", o.alpha_less);
   o.similar_band = yaml.getDouble(p + "similar_band", o.similar_band);
-  const std::string measure =
-      yaml.getString(p + "track_measure", o.weights_by_count ? "count" : "length");
-  if (measure != "length" && measure != "count")
-    throw Error(yaml.where(p + "track_measure") + " must be length or count, not '" + measure +
-                "'");
-  o.weights_by_count = measure == "count";
+  o.weights_by_count = yaml.getChoice(p + "track_measure", o.weights_by_count ? "count" : "length",
+                                      {"length", "count"}) == "count";
   o.normalize_weights = yaml.getBool(p + "normalize_weights", o.normalize_weights);
   const bool costs = o.weights_on == WeightTarget::kCosts;
-  const std::string weights_on = yaml.getString(p + "weights_on", costs ? "costs" : "residuals");
-  if (weights_on != "costs" && weights_on != "residuals")
-    throw Error(yaml.where(p + "weights_on") + " must be residuals or costs, not '" + weights_on +
-                "'");
+  const std::string weights_on =
+      yaml.getChoice(p + "weights_on", costs ? "costs" : "residuals", {"residuals", "costs"});
   o.weights_on = weights_on == "costs" ? WeightTarget::kCosts : WeightTarget::kResiduals;
   for (const char* k : {"alpha_more", "alpha_similar", "alpha_less"})
     if (yaml.getDouble(p + k, 1.0) <= 0) throw Error(yaml.where(p + k) + " must be positive");

@@ -30,11 +30,8 @@ PointTrackerOptions PointTrackerOptions::load(const YamlReader& yaml, const std:
   an.reanchor_frames = yaml.getInt(a + "reanchor_frames", an.reanchor_frames);
   an.max_iterations = yaml.getInt(a + "max_iterations", an.max_iterations);
   an.min_zncc = yaml.getDouble(a + "min_zncc", an.min_zncc);
-  an.warp = yaml.getString(a + "warp", an.warp);
+  an.warp = yaml.getChoice(a + "warp", an.warp, {"translation", "similarity", "affine"});
   an.end_mismatched = yaml.getBool(a + "end_mismatched", an.end_mismatched);
-  if (an.warp != "translation" && an.warp != "similarity" && an.warp != "affine")
-    throw Error(yaml.where(a + "warp") + " must be translation, similarity or affine, not '" +
-                an.warp + "'");
   if (an.window < 5 || an.window % 2 == 0)
     throw Error(yaml.where(a + "window") + " must be an odd number >= 5");
   if (an.max_shift_px <= 0) throw Error(yaml.where(a + "max_shift_px") + " must be positive");

@@ -45,6 +45,9 @@ class YamlReader {
   bool getBool(const std::string& key, bool fallback) const;
   std::string getString(const std::string& key, const std::string& fallback) const;
   std::vector<double> getDoubles(const std::string& key, const std::vector<double>& fallback) const;
+  /// One word out of `choices`; anything else throws "<where> must be a, b or c, not 'x'".
+  std::string getChoice(const std::string& key, const std::string& fallback,
+                        const std::vector<std::string>& choices) const;
 
   /// Mark a key (and everything under it) as known without reading it.
   void markKnown(const std::string& key) const;
