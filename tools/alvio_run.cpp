@@ -3,6 +3,7 @@
 // (octomap.bt, lines.ply, lines.csv, map.3Dscene) unless mapping.enabled is false.
 // SIGINT/SIGTERM stop the run early; everything processed so far is still written.
 #include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -25,7 +26,27 @@
 #include "alvio/pipeline/vio_pipeline.h"
 #include "rosbag_source.h"
 
+#ifdef ALVIO_WITH_MIMALLOC
+#include <mimalloc.h>
+#endif
+
 using namespace alvio;
+
+namespace {
+// mimalloc, when linked, has replaced malloc for the whole process (it keeps freed pages for
+// reuse by itself); else glibc's malloc is told to keep freed memory. Checked on a real
+// allocation, so that a linker that dropped the library shows.
+std::string useFastAllocator() {
+#ifdef ALVIO_WITH_MIMALLOC
+  void* probe = std::malloc(64);
+  const bool replaced = mi_is_in_heap_region(probe);
+  std::free(probe);
+  if (replaced) return "mimalloc " + std::to_string(mi_version());
+#endif
+  alvio::retainFreedHeapMemory();  // per-frame image temporaries stay mapped
+  return "glibc malloc, freed memory kept";
+}
+}  // namespace
 
 int main(int argc, char** argv) {
   ArgParser args("alvio run",
@@ -50,6 +71,8 @@ int main(int argc, char** argv) {
   try {
     if (!args.parse(argc, argv)) return 0;
     if (args.isSet("verbose")) setLogLevel(LogLevel::kDebug);
+    const std::string allocator = useFastAllocator();
+    logDebug("memory allocator: ", allocator);
     if (args.isSet("opencv-threads")) {
       const int threads = args.getInt("opencv-threads");
       if (threads < 1)
@@ -94,7 +117,6 @@ int main(int argc, char** argv) {
     options.max_frames = args.getInt("max-frames");
     options.progress = !args.isSet("quiet");
     options.stop = &installStopSignalHandlers();
-    retainFreedHeapMemory();  // per-frame image temporaries stay mapped
     std::unique_ptr<RunLogger> logger;
     if (config.logger.enabled && !args.isSet("no-log")) {
       logger = std::make_unique<RunLogger>(config.logger);

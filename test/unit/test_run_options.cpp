@@ -46,3 +46,13 @@ TEST(RunOptions, OneOpenCvThreadStillReachesTheInput) {
   EXPECT_EQ(o.output.find("--opencv-threads"), std::string::npos) << o.output;
   EXPECT_NE(o.output.find("/nowhere"), std::string::npos) << o.output;
 }
+
+TEST(RunOptions, TheAllocatorInUseIsTheOneBuiltIn) {
+  // Checked on a live allocation: a linker that dropped mimalloc would leave glibc's malloc.
+  const Outcome o = runWith("--verbose");
+#ifdef ALVIO_EXPECT_MIMALLOC
+  EXPECT_NE(o.output.find("memory allocator: mimalloc"), std::string::npos) << o.output;
+#else
+  EXPECT_NE(o.output.find("memory allocator: glibc malloc"), std::string::npos) << o.output;
+#endif
+}
