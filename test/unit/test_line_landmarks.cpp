@@ -234,22 +234,17 @@ LineLandmark retireWithEdgePositions(int on_edge, const LineRetirementFilter& fi
 }
 }  // namespace
 
-TEST(LineLandmarks, RetirementFitsTheEdgePositionsWhereverTheEdgeWasLookedFor) {
+TEST(LineLandmarks, RetirementFitsTheEdgePositionsWhenHalfTheTrackHasThem) {
   const LineLandmark all = retireWithEdgePositions(8);
   EXPECT_EQ(all.track_observations, 8);
   EXPECT_LT(extentError(all), 1e-6);
-  // Looked for on four frames only (the flow on the raw image: the frames with detection),
-  // found on all four: those four, the others left out.
   const LineLandmark half = retireWithEdgePositions(4);
-  EXPECT_EQ(half.track_observations, 4);
+  EXPECT_EQ(half.track_observations, 4);  // the four on the edge, the others left out
   EXPECT_LT(extentError(half), 1e-6);
+  // Fewer than half: the tracker's positions, 3 cm off.
   const LineLandmark few = retireWithEdgePositions(3);
-  EXPECT_EQ(few.track_observations, 3);
-  EXPECT_LT(extentError(few), 1e-6);
-  // Never looked for (lines.map_edges off): the tracker's positions, 3 cm off.
-  const LineLandmark none = retireWithEdgePositions(0);
-  EXPECT_EQ(none.track_observations, 8);
-  EXPECT_NEAR(extentError(none), 0.03, 0.01);
+  EXPECT_EQ(few.track_observations, 8);
+  EXPECT_NEAR(extentError(few), 0.03, 0.01);
 }
 
 TEST(LineLandmarks, TracksOnTheirEdgesMeetTheEdgeFitLimit) {
@@ -263,9 +258,9 @@ TEST(LineLandmarks, TracksOnTheirEdgesMeetTheEdgeFitLimit) {
   filter.max_edge_reprojection_rms = 0.3 / 458.0;
   retireWithEdgePositions(8, filter, 0.4, &counts);
   EXPECT_EQ(counts.held_back_fit, 1);
-  // A track fitted on the tracker's positions (no edge looked for) meets the other limit.
+  // A track fitted on the tracker's positions (too few on the edge) meets the other limit.
   filter.max_edge_reprojection_rms = 0;
-  EXPECT_EQ(retireWithEdgePositions(0, filter, 0.4, &counts).track_observations, 8);
+  EXPECT_EQ(retireWithEdgePositions(3, filter, 0.4, &counts).track_observations, 8);
   EXPECT_EQ(counts.retired, 1);
 }
 

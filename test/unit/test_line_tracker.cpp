@@ -592,62 +592,6 @@ TEST(LineTracker, DistortedStraightEdgeComesOutStraightInNormalisedCoordinates) 
   EXPECT_EQ(found, 2);
 }
 
-namespace {
-// A bar straight in normalised coordinates (from a to b, half-width `half`), drawn through the
-// camera's distortion into a raw image.
-cv::Mat distortedBar(const CameraModel& model, const Eigen::Vector2d& a, const Eigen::Vector2d& b,
-                     double half) {
-  const Eigen::Vector2d u = (b - a).normalized(), n(-u.y(), u.x());
-  cv::Mat raw(kSize, CV_8UC1, cv::Scalar(150));
-  constexpr int kShift = 4;
-  std::vector<cv::Point> poly;
-  auto add = [&](const Eigen::Vector2d& xy) {
-    const Eigen::Vector2d px = model.distort(xy);
-    poly.emplace_back(cvRound(px.x() * (1 << kShift)), cvRound(px.y() * (1 << kShift)));
-  };
-  for (int i = 0; i <= 100; ++i) add(a + (b - a) * (i / 100.0) + half * n);
-  for (int i = 100; i >= 0; --i) add(a + (b - a) * (i / 100.0) - half * n);
-  cv::fillPoly(raw, std::vector<std::vector<cv::Point>>{poly}, cv::Scalar(40), cv::LINE_AA, kShift);
-  return raw;
-}
-}  // namespace
-
-TEST(OpticalFlowLineTracker, FlowOnTheRawImageCarriesLinesThroughTheDistortion) {
-  // A bar near the top of a EuRoC image (curved there in the raw image) moves between two
-  // frames; the second is not detected, so its lines are the flow's predictions. Moved in the
-  // raw image and mapped back, they lie on the moved bar's straight edges as the pinhole
-  // image's flow does, and that frame needs no pinhole image (no edge positions for the map).
-  const CameraOptions camera = Config::load(test::sourcePath("config/euroc.yaml")).camera;
-  const auto model = CameraModel::create(camera);
-  const Eigen::Vector2d a(-0.62, -0.40), b(0.58, -0.36), shift(0.012, 0.008);
-  const double half = 0.03;
-  const Eigen::Vector2d u = (b - a).normalized(), n(-u.y(), u.x());
-  const cv::Mat f1 = distortedBar(*model, a, b, half);
-  const cv::Mat f2 = distortedBar(*model, a + shift, b + shift, half);
-  for (const std::string image : {"pinhole", "raw"}) {
-    LineTrackerOptions options;
-    options.flow.detect_every = 2;
-    options.flow.klt_image = image;
-    options.map_edges = true;
-    OpticalFlowLineTracker tracker(camera, options);
-    const LineFrame first = tracker.track(f1, 0.0);
-    const LineFrame second = tracker.track(f2, 0.05);
-    EXPECT_EQ(second.stats.detected, 0) << image;
-    EXPECT_EQ(second.stats.tracked, static_cast<int>(first.lines.size())) << image;
-    const double tol = 1.0 / camera.intrinsics[0];
-    int on_edge = 0;
-    for (const auto& obs : second.lines) {
-      EXPECT_EQ(obs.edge_checked, image == "pinhole") << image;
-      for (double side : {1.0, -1.0}) {
-        const Eigen::Vector2d p0 = a + shift + side * half * n;
-        auto dist = [&](const Eigen::Vector2d& q) { return std::abs(n.dot(q - p0)); };
-        on_edge += dist(obs.start_norm) < tol && dist(obs.end_norm) < tol;
-      }
-    }
-    EXPECT_EQ(on_edge, 2) << image;
-  }
-}
-
 TEST(LineTrackerOptions, LoadFromYamlAndNameBadKeys) {
   const auto yaml = YamlReader::fromString(
       "lines:\n  tracker: descriptor\n  detector: {max_lines: 25, lsd_scale: 0.8, lsd_quant: 4}\n"
@@ -681,11 +625,6 @@ TEST(LineTrackerOptions, LoadFromYamlAndNameBadKeys) {
   EXPECT_THROW(LineTrackerOptions::load(bad_quant, "lines"), Error);
   const auto bad_tracker = YamlReader::fromString("lines:\n  tracker: magic\n", "t.yaml");
   EXPECT_THROW(LineTrackerOptions::load(bad_tracker, "lines"), Error);
-  const auto bad_image = YamlReader::fromString("lines:\n  flow: {klt_image: fisheye}\n", "i.yaml");
-  const std::string image_error =
-      test::errorOf([&] { LineTrackerOptions::load(bad_image, "lines"); });
-  EXPECT_NE(image_error.find("lines.flow.klt_image"), std::string::npos) << image_error;
-  EXPECT_NE(image_error.find("fisheye"), std::string::npos) << image_error;
 }
 
 TEST(LineTracker, EurocFramesAreDetectedAndTracked) {

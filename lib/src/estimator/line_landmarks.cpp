@@ -85,18 +85,16 @@ void LineLandmarks::removeFrame(int64_t frame_ns, const Eigen::Isometry3d* T_w_c
 
 void LineLandmarks::retire(const LineLandmark& l, const TrackHistory& history) {
   // One refinement over every observation of the track, for the map: over those found on
-  // their full-resolution edge (lines.map_edges) when they are at least half of the views
-  // looked for there (every view, or the views with detection when the flow runs on the raw
-  // image). The others are left out, not mixed in: the two positions differ by a few tenths
-  // of a pixel, and tracks mixing them fitted worse (docs/benchmarks.md, eighteenth session).
-  const bool on_edges = history.edge_checks > 0 &&
-                        2 * static_cast<int>(history.edge_views.size()) >= history.edge_checks;
+  // their full-resolution edge (lines.map_edges) when they are at least half of the track.
+  // The others are left out, not mixed in: the two positions differ by a few tenths of a
+  // pixel, and tracks mixing them fitted worse (docs/benchmarks.md, eighteenth session).
+  const bool on_edges = 2 * history.edge_views.size() >= history.views.size();
   const LineViews& views = on_edges ? history.edge_views : history.views;
   if (!usableForRetirement(l, views)) return;
-  // Looked for but found on fewer than half of those views: no single clean edge there, and
+  // Looked for on most frames but found on fewer than half: no single clean edge there, and
   // such tracks were the map's least precise (sim_MH_05: 77.7 % precision without them, 71.3 %
   // with them at the tracker's 0.5 px limit).
-  if (!on_edges && history.edge_checks > 0) {
+  if (!on_edges && 2 * history.edge_checks >= static_cast<int>(history.views.size())) {
     ++counts_.held_back_edge;
     return;
   }

@@ -12,7 +12,7 @@ DescriptorLineTracker::DescriptorLineTracker(const CameraOptions& camera,
                                              const LineTrackerOptions& options)
     : LineTracker(camera, options) {}
 
-void DescriptorLineTracker::associate(const cv::Mat& /*raw*/, const cv::Mat& undistorted,
+void DescriptorLineTracker::associate(const cv::Mat& undistorted,
                                       const std::vector<LineSegment>& detections, bool /*detected*/,
                                       LineFrame* frame) {
   const auto& o = options_.descriptor;

@@ -18,8 +18,7 @@ ImageUndistorter::ImageUndistorter(const CameraOptions& camera)
   if (!has_distortion_) return;
 
   // For every pinhole pixel: its normalised ray, distorted into the raw image.
-  model_ = CameraModel::create(camera);
-  const CameraModel* model = model_.get();
+  const auto model = CameraModel::create(camera);
   cv::Mat map_x(size_, CV_32FC1), map_y(size_, CV_32FC1);
   for (int v = 0; v < size_.height; ++v) {
     for (int u = 0; u < size_.width; ++u) {
@@ -33,14 +32,6 @@ ImageUndistorter::ImageUndistorter(const CameraOptions& camera)
   const cv::Mat ones(size_, CV_8UC1, cv::Scalar(255));
   cv::remap(ones, valid_mask_, map_xy_, map_frac_, cv::INTER_NEAREST, cv::BORDER_CONSTANT,
             cv::Scalar(0));
-}
-
-Eigen::Vector2d ImageUndistorter::pinholeToRaw(const Eigen::Vector2d& px) const {
-  return has_distortion_ ? model_->distort(pixelToNormalised(px)) : px;
-}
-
-Eigen::Vector2d ImageUndistorter::rawToPinhole(const Eigen::Vector2d& px) const {
-  return has_distortion_ ? normalisedToPixel(model_->undistort(px)) : px;
 }
 
 cv::Mat ImageUndistorter::undistort(const cv::Mat& raw) const {

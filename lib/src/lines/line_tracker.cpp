@@ -23,19 +23,21 @@ LineTracker::LineTracker(const CameraOptions& camera, const LineTrackerOptions& 
 }
 
 LineFrame LineTracker::track(const cv::Mat& gray, double t) {
-  if (gray.type() != CV_8UC1 || gray.size() != undistorter_.size())
+  const auto start = std::chrono::steady_clock::now();
+  const cv::Mat undistorted = undistorter_.undistort(gray);
+  const double undistort_ms = msSince(start);
+  LineFrame frame = trackUndistorted(undistorted, t);
+  frame.stats.undistort_ms = undistort_ms;
+  return frame;
+}
+
+LineFrame LineTracker::trackUndistorted(const cv::Mat& undistorted, double t) {
+  if (undistorted.type() != CV_8UC1 || undistorted.size() != undistorter_.size())
     throw Error(std::string(name()) + ": expected an 8-bit grey image of the camera's size");
   LineFrame frame;
   frame.t = t;
-  const bool detect = detectsThisFrame();
-  // The pinhole image is for the detector and the edge positions; a tracker whose flow runs
-  // on the raw image needs it only where it detects.
   auto start = std::chrono::steady_clock::now();
-  const cv::Mat undistorted =
-      detect || !flowOnRawImage() ? undistorter_.undistort(gray) : cv::Mat();
-  frame.stats.undistort_ms = msSince(start);
-
-  start = std::chrono::steady_clock::now();
+  const bool detect = detectsThisFrame();
   const std::vector<LineSegment> detections =
       detect ? detector_.detect(undistorted, undistorter_.validMask()) : std::vector<LineSegment>();
   frame.stats.detect_ms = msSince(start);
@@ -43,14 +45,13 @@ LineFrame LineTracker::track(const cv::Mat& gray, double t) {
     frame.stats.detected += s.length() >= detector_.minLength();
 
   start = std::chrono::steady_clock::now();
-  associate(gray, undistorted, detections, detect, &frame);
-  const bool check_edges = options_.map_edges && !undistorted.empty();
+  associate(undistorted, detections, detect, &frame);
   for (LineObservation& obs : frame.lines) {
     obs.start_norm = undistorter_.pixelToNormalised(obs.start_px);
     obs.end_norm = undistorter_.pixelToNormalised(obs.end_px);
     LineSegment edge(obs.start_px, obs.end_px);
-    obs.edge_checked = check_edges;
-    if (check_edges && refineSegmentToEdge(undistorted, EdgeRefinementOptions(), &edge)) {
+    obs.edge_checked = options_.map_edges;
+    if (options_.map_edges && refineSegmentToEdge(undistorted, EdgeRefinementOptions(), &edge)) {
       obs.on_edge = true;
       obs.edge_start_norm = undistorter_.pixelToNormalised(edge.start);
       obs.edge_end_norm = undistorter_.pixelToNormalised(edge.end);

@@ -75,7 +75,6 @@ FlowLineTrackerOptions FlowLineTrackerOptions::load(const YamlReader& yaml,
   o.klt_pyramid_levels = yaml.getInt(p + "klt_pyramid_levels", o.klt_pyramid_levels);
   o.klt_max_iterations = yaml.getInt(p + "klt_max_iterations", o.klt_max_iterations);
   o.klt_epsilon = yaml.getDouble(p + "klt_epsilon", o.klt_epsilon);
-  o.klt_image = yaml.getChoice(p + "klt_image", o.klt_image, {"pinhole", "raw"});
   o.knn = yaml.getInt(p + "knn", o.knn);
   o.max_angle_deg = yaml.getDouble(p + "max_angle_deg", o.max_angle_deg);
   o.max_line_distance_px = yaml.getDouble(p + "max_line_distance_px", o.max_line_distance_px);

@@ -75,8 +75,7 @@ bool OpticalFlowLineTracker::predictOne(const Track& track, const std::vector<cv
   for (int k = 0; k < n; ++k) {
     const cv::Point2f& p = moved[first + k];
     if (!status[first + k] || !std::isfinite(p.x) || !std::isfinite(p.y)) continue;
-    Eigen::Vector2d before = track.segment.start + k * step;
-    if (flowOnRawImage()) before = undistorter().pinholeToRaw(before);  // the flow image's border
+    const Eigen::Vector2d before = track.segment.start + k * step;
     if (before.x() < margin || before.y() < margin || before.x() > image_size.width - 1 - margin ||
         before.y() > image_size.height - 1 - margin)
       continue;
@@ -139,9 +138,11 @@ void OpticalFlowLineTracker::predict(const std::vector<cv::Mat>& pyramid, cv::Si
   std::vector<cv::Point2f> samples;
   samples.reserve(tracks_.size() * n);
   for (const Track& track : tracks_) {
-    for (int k = 0; k < n; ++k)
-      samples.push_back(toFlowImage(
-          track.segment.start + (track.segment.end - track.segment.start) * (double(k) / (n - 1))));
+    for (int k = 0; k < n; ++k) {
+      const Eigen::Vector2d p =
+          track.segment.start + (track.segment.end - track.segment.start) * (double(k) / (n - 1));
+      samples.emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()));
+    }
   }
   std::vector<cv::Point2f> moved;
   std::vector<uchar> status;
@@ -158,29 +159,13 @@ void OpticalFlowLineTracker::predict(const std::vector<cv::Mat>& pyramid, cv::Si
     const int corner = cvFloor(x - half);
     return corner < -f.klt_window_px || corner >= size;
   };
-  for (std::size_t i = 0; i < moved.size(); ++i) {
+  for (std::size_t i = 0; i < moved.size(); ++i)
     if (status[i] &&
         (outside(moved[i].x, image_size.width) || outside(moved[i].y, image_size.height)))
       status[i] = 0;
-    // The lines are fitted in the pinhole image.
-    if (flowOnRawImage() && status[i] && std::isfinite(moved[i].x) && std::isfinite(moved[i].y)) {
-      const Eigen::Vector2d p = fromFlowImage(moved[i]);
-      moved[i] = cv::Point2f(static_cast<float>(p.x()), static_cast<float>(p.y()));
-    }
-  }
   for (std::size_t i = 0; i < tracks_.size(); ++i)
     predictions_[i].valid =
         predictOne(tracks_[i], moved, status, i * n, image_size, &predictions_[i]);
-}
-
-cv::Point2f OpticalFlowLineTracker::toFlowImage(const Eigen::Vector2d& pinhole_px) const {
-  const Eigen::Vector2d p = flowOnRawImage() ? undistorter().pinholeToRaw(pinhole_px) : pinhole_px;
-  return {static_cast<float>(p.x()), static_cast<float>(p.y())};
-}
-
-Eigen::Vector2d OpticalFlowLineTracker::fromFlowImage(const cv::Point2f& flow_px) const {
-  const Eigen::Vector2d p(flow_px.x, flow_px.y);
-  return flowOnRawImage() ? undistorter().rawToPinhole(p) : p;
 }
 
 bool OpticalFlowLineTracker::detectsThisFrame() {
@@ -201,18 +186,17 @@ bool OpticalFlowLineTracker::detectsThisFrame() {
   return false;
 }
 
-void OpticalFlowLineTracker::associate(const cv::Mat& raw, const cv::Mat& undistorted,
+void OpticalFlowLineTracker::associate(const cv::Mat& undistorted,
                                        const std::vector<LineSegment>& detections, bool detected,
                                        LineFrame* frame) {
   const auto& f = options_.flow;
-  const cv::Mat& image = flowOnRawImage() ? raw : undistorted;
   std::vector<cv::Mat> pyramid;
   // Built once per frame and kept as the next frame's previous pyramid. Never share the
   // caller's buffer (tryReuseInputImage = false): it may be overwritten after we return.
-  cv::buildOpticalFlowPyramid(image, pyramid, cv::Size(f.klt_window_px, f.klt_window_px),
+  cv::buildOpticalFlowPyramid(undistorted, pyramid, cv::Size(f.klt_window_px, f.klt_window_px),
                               f.klt_pyramid_levels, true, cv::BORDER_REFLECT_101,
                               cv::BORDER_CONSTANT, false);
-  predict(pyramid, image.size());
+  predict(pyramid, undistorted.size());
   std::vector<Track> next = detected ? match(detections, frame) : carryPredictions(frame);
 
   frame->lines.clear();

@@ -20,9 +20,8 @@ class DescriptorLineTracker final : public LineTracker {
 
  protected:
   /// Detects on every frame (descriptors need detections), so `detected` is always true.
-  void associate(const cv::Mat& raw, const cv::Mat& undistorted,
-                 const std::vector<LineSegment>& detections, bool detected,
-                 LineFrame* frame) override;
+  void associate(const cv::Mat& undistorted, const std::vector<LineSegment>& detections,
+                 bool detected, LineFrame* frame) override;
 
  private:
   LbdExtractor lbd_;

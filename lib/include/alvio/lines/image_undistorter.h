@@ -7,14 +7,11 @@
 // own CameraModel, so every distortion model it supports is handled the same way.
 
 #include <Eigen/Core>
-#include <memory>
 #include <opencv2/core.hpp>
 
 #include "alvio/config/sensor_options.h"
 
 namespace alvio {
-
-class CameraModel;
 
 class ImageUndistorter {
  public:
@@ -39,9 +36,6 @@ class ImageUndistorter {
   Eigen::Vector2d normalisedToPixel(const Eigen::Vector2d& xy) const {
     return {fx_ * xy.x() + cx_, fy_ * xy.y() + cy_};
   }
-  /// A pinhole-image pixel in the raw image, and back (the identity without distortion).
-  Eigen::Vector2d pinholeToRaw(const Eigen::Vector2d& px) const;
-  Eigen::Vector2d rawToPinhole(const Eigen::Vector2d& px) const;
 
  private:
   cv::Size size_;
@@ -49,7 +43,6 @@ class ImageUndistorter {
   bool has_distortion_;
   cv::Mat map_xy_, map_frac_;  // fixed-point remap tables (cv::convertMaps)
   cv::Mat valid_mask_;
-  std::shared_ptr<const CameraModel> model_;
 };
 
 }  // namespace alvio

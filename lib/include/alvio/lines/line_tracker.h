@@ -39,6 +39,8 @@ class LineTracker {
 
   /// Process one raw (distorted) 8-bit grey image taken at time t [s].
   LineFrame track(const cv::Mat& gray, double t);
+  /// Same, for an image already undistorted with undistorter() (to share the remap).
+  LineFrame trackUndistorted(const cv::Mat& undistorted, double t);
 
   const ImageUndistorter& undistorter() const { return undistorter_; }
   const LineTrackerOptions& options() const { return options_; }
@@ -47,16 +49,11 @@ class LineTracker {
  protected:
   /// Whether the detector runs on this frame (called once per frame, before associate()).
   virtual bool detectsThisFrame() { return true; }
-  /// Whether associate() reads only the raw image on frames without detection (then the
-  /// pinhole image is not made for them).
-  virtual bool flowOnRawImage() const { return false; }
   /// Associate this frame's detections with the previous frame's lines: fill `frame.lines`
-  /// (pinhole pixel coordinates, id, track_count) and the association counters of
-  /// `frame.stats`. `detected` is false when detectsThisFrame() skipped the detector
-  /// (`detections` is empty); `undistorted` is then empty if flowOnRawImage().
-  virtual void associate(const cv::Mat& raw, const cv::Mat& undistorted,
-                         const std::vector<LineSegment>& detections, bool detected,
-                         LineFrame* frame) = 0;
+  /// (pixel coordinates, id, track_count) and the association counters of `frame.stats`.
+  /// `detected` is false when detectsThisFrame() skipped the detector (`detections` is empty).
+  virtual void associate(const cv::Mat& undistorted, const std::vector<LineSegment>& detections,
+                         bool detected, LineFrame* frame) = 0;
   const LineDetector& detector() const { return detector_; }
   int newId() { return next_id_++; }
   /// The unused detections that start new lines this frame: long enough for a new line,

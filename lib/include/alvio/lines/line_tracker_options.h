@@ -65,11 +65,6 @@ struct FlowLineTrackerOptions {
   int klt_pyramid_levels = 3;
   int klt_max_iterations = 30;
   double klt_epsilon = 0.01;
-  /// The image KLT moves the samples in: "pinhole" (the undistorted image the detector sees)
-  /// or "raw" (the camera's image, samples mapped through the distortion). Raw spares the
-  /// undistortion on frames without detection, whose observations are then not placed on
-  /// their full-resolution edge for the map (map_edges).
-  std::string klt_image = "pinhole";
   /// Candidate detections kept per predicted line (the K of the KNN matching).
   int knn = 4;
   /// A detection matches a predicted line if its direction differs by at most this angle

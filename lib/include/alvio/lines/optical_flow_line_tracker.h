@@ -43,10 +43,8 @@ class OpticalFlowLineTracker final : public LineTracker {
 
  protected:
   bool detectsThisFrame() override;
-  bool flowOnRawImage() const override { return options_.flow.klt_image == "raw"; }
-  void associate(const cv::Mat& raw, const cv::Mat& undistorted,
-                 const std::vector<LineSegment>& detections, bool detected,
-                 LineFrame* frame) override;
+  void associate(const cv::Mat& undistorted, const std::vector<LineSegment>& detections,
+                 bool detected, LineFrame* frame) override;
 
  private:
   struct Track {
@@ -55,9 +53,6 @@ class OpticalFlowLineTracker final : public LineTracker {
     int count;
   };
   void predict(const std::vector<cv::Mat>& pyramid, cv::Size image_size);
-  /// A pinhole-image point in the image the flow runs on, and back.
-  cv::Point2f toFlowImage(const Eigen::Vector2d& pinhole_px) const;
-  Eigen::Vector2d fromFlowImage(const cv::Point2f& flow_px) const;
   /// Steps 2 and 3: this frame's lines from the predictions and the detections.
   std::vector<Track> match(const std::vector<LineSegment>& detections, LineFrame* frame);
   /// A frame without detections: the valid predictions are this frame's lines.
