@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Copy the built programs and libraries into a folder of their own, so that long benchmark
 # runs are not broken by a rebuild of build/ underneath them (a relinked program with the
-# old library, or the reverse). Prints the frozen alvio_run; run it with
-# LD_LIBRARY_PATH=<folder>/lib (LD_LIBRARY_PATH comes before the build's RUNPATH).
+# old library, or the reverse). Prints the frozen alvio_run. The copies' RUNPATH points at
+# each other (patchelf), so a frozen program run by hand loads the frozen libraries too.
 #
 #   scripts/freeze_build.sh OUT_DIR        (scripts/bench.py --freeze does it for you)
 set -euo pipefail
@@ -34,6 +34,16 @@ refuse_during_build
 mkdir -p "$out/lib" "$out/bin"
 cp -a "$BUILD"/devel/lib/*.so* "$out/lib/"
 cp -a "$BUILD"/devel/lib/alvio/alvio_run "$BUILD"/devel/lib/alvio/alvio_sim "$out/bin/"
+# The build's RUNPATH names build/devel/lib: without this a frozen program run by hand loads
+# the live libraries, whose types may have changed since (a crash in a destructor).
+is_elf() { [[ "$(head -c 4 "$1" | od -An -c | tr -d ' ')" == '177ELF' ]]; }
+for f in "$out"/bin/* "$out"/lib/*.so*; do
+  [[ -f $f && ! -L $f ]] && is_elf "$f" || continue
+  # shellcheck disable=SC2016
+  case "$f" in "$out"/bin/*) rpath='$ORIGIN/../lib' ;; *) rpath='$ORIGIN' ;; esac
+  patchelf --set-rpath "$rpath" "$f" ||
+    { echo "freeze_build.sh: patchelf failed on $f (apt-get install patchelf)" >&2; exit 1; }
+done
 # A build that started during the copy may have replaced some of the files already copied.
 refuse_during_build
 echo "$out/bin/alvio_run"

@@ -2,6 +2,7 @@
 libraries, and refuses while a build tool works in the folder (a copy taken mid-link mixes
 old and new files)."""
 import os
+import shutil
 import subprocess
 import tempfile
 import unittest
@@ -54,6 +55,36 @@ class FreezeBuildTest(unittest.TestCase):
         self.assertFalse((self.out / "bin/alvio_run").exists())
         # Once the build is over, the same freeze goes through.
         self.assertEqual(self.freeze().returncode, 0)
+
+    @unittest.skipUnless(shutil.which("gcc") and shutil.which("patchelf"), "needs gcc and patchelf")
+    def test_frozen_program_loads_the_frozen_library(self):
+        # A real program linked with its build's RUNPATH, as catkin links alvio_run: frozen, then
+        # the build's library is rebuilt; run by hand without LD_LIBRARY_PATH, the frozen
+        # program must still load the frozen library.
+        lib = self.build / "devel/lib"
+        src = Path(self.tmp.name) / "src"
+        src.mkdir()
+
+        def build_library(version):
+            (src / "core.c").write_text(f"int core_version(void) {{ return {version}; }}\n")
+            subprocess.run(["gcc", "-shared", "-fPIC", "-o", str(lib / "libalvio_core.so"),
+                            str(src / "core.c")], check=True)
+
+        build_library(1)
+        (src / "run.c").write_text('#include <stdio.h>\nint core_version(void);\n'
+                                   'int main(void) { printf("%d", core_version()); return 0; }\n')
+        subprocess.run(["gcc", "-o", str(lib / "alvio/alvio_run"), str(src / "run.c"), f"-L{lib}",
+                        "-lalvio_core", f"-Wl,-rpath,{lib}"], check=True)
+        self.assertEqual(self.freeze().returncode, 0)
+        build_library(2)
+        env = {k: v for k, v in os.environ.items() if k != "LD_LIBRARY_PATH"}
+        live = subprocess.run([str(lib / "alvio/alvio_run")], env=env, capture_output=True, text=True)
+        frozen = subprocess.run([str(self.out / "bin/alvio_run")], env=env, capture_output=True,
+                                text=True)
+        self.assertEqual(live.stdout, "2")
+        self.assertEqual(frozen.stdout, "1", frozen.stderr)
+        # The stand-in's other files (text, not programs) were copied as they were.
+        self.assertEqual((self.out / "bin/alvio_sim").read_text(), "alvio_sim")
 
     def test_missing_build_names_it(self):
         self.build = Path(self.tmp.name) / "nowhere"
