@@ -128,6 +128,14 @@ TEST(Config, PointDriftIsReadAndANegativeDriftIsRejected) {
                         {"estimator.point_drift_px2_per_s", "must not be negative"});
 }
 
+TEST(Config, AnUnknownRobustLossIsRejectedByName) {
+  const std::string path =
+      test::writeFile(test::scratchDir() + "/loss.yaml",
+                      eurocYamlReplacing("robust_loss: cauchy", "robust_loss: tukey"));
+  expectErrorMentioning([&] { Config::load(path); },
+                        {"estimator.robust_loss", "must be cauchy, huber or none, not 'tukey'"});
+}
+
 TEST(Config, ClaheSettingsAreReadAndNonPositiveOnesAreRejected) {
   const Config c = Config::load(test::sourcePath("config/euroc.yaml"));
   EXPECT_DOUBLE_EQ(c.points.clahe_clip_limit, 3.0);

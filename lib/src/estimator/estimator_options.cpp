@@ -17,7 +17,7 @@ EstimatorOptions EstimatorOptions::load(const YamlReader& yaml, const std::strin
   o.num_threads = yaml.getInt(p + "num_threads", o.num_threads);
   o.point_sigma_px = yaml.getDouble(p + "point_sigma_px", o.point_sigma_px);
   o.point_drift_px2_per_s = yaml.getDouble(p + "point_drift_px2_per_s", o.point_drift_px2_per_s);
-  o.robust_loss = yaml.getString(p + "robust_loss", o.robust_loss);
+  o.robust_loss = yaml.getChoice(p + "robust_loss", o.robust_loss, {"cauchy", "huber", "none"});
   o.robust_loss_scale = yaml.getDouble(p + "robust_loss_scale", o.robust_loss_scale);
   o.outlier_reprojection_px =
       yaml.getDouble(p + "outlier_reprojection_px", o.outlier_reprojection_px);
@@ -81,9 +81,6 @@ EstimatorOptions EstimatorOptions::load(const YamlReader& yaml, const std::strin
   if (o.line_map_min_parallax < 0)
     throw Error(yaml.where(p + "line_map_min_parallax") + " must not be negative (0: no limit)");
   if (o.imu_noise_scale <= 0) throw Error(yaml.where(p + "imu_noise_scale") + " must be positive");
-  if (o.robust_loss != "cauchy" && o.robust_loss != "huber" && o.robust_loss != "none")
-    throw Error(yaml.where(p + "robust_loss") + ": unknown loss '" + o.robust_loss +
-                "' (expected cauchy, huber or none)");
   return o;
 }
 
