@@ -2,6 +2,9 @@
 // image_transport, tracks points and lines (alvio::FrontEnd) and publishes ~frame:
 // the features together with the very image it received (SharedTrackedFrame), so
 // that the estimator and logger nodelets of the same manager get it without a copy.
+// With the gyroscope's flow on (points.gyro_flow, lines.flow.gyro_flow) it also
+// subscribes to the IMU, and an image waits until an IMU sample after it has come:
+// the trackers then get exactly the rotation the offline runner gives them.
 #include <cv_bridge/cv_bridge.h>
 #include <image_transport/image_transport.h>
 #include <nodelet/nodelet.h>
@@ -10,10 +13,14 @@
 
 #include <alvio/PipelineStatus.h>
 
+#include <algorithm>
 #include <memory>
+#include <optional>
+#include <vector>
 
 #include "alvio/common/clock_jump.h"
 #include "alvio/common/error.h"
+#include "alvio/pipeline/frame_imu_sync.h"
 #include "alvio/pipeline/front_end.h"
 #include "conversions.h"
 #include "core_log_route.h"
@@ -24,8 +31,16 @@
 
 namespace alvio_ros {
 
+// Callbacks come from getNodeHandle()'s single-threaded queue: they never run at once.
 class TrackerNodelet : public GuardedNodelet {
  private:
+  struct PendingImage {
+    sensor_msgs::ImageConstPtr image;
+    cv_bridge::CvImageConstPtr gray;
+    ros::WallTime received;
+  };
+  using Sync = alvio::FrameImuSynchronizer<PendingImage>;
+
   void init() override {
     ros::NodeHandle& nh = getNodeHandle();
     ros::NodeHandle& pnh = getPrivateNodeHandle();
@@ -35,8 +50,13 @@ class TrackerNodelet : public GuardedNodelet {
     const std::string transport = param(pnh, "image_transport", "raw");
     const std::string status_topic = param(pnh, "status_topic", "estimator/status");
     const int queue = param(pnh, "queue_size", 5);
+    const std::string imu_topic = param(pnh, "imu_topic", config.config().topics.imu);
     requireParam(!image_topic.empty(), pnh, "image_topic", "is empty");
     requireParam(queue > 0, pnh, "queue_size", "must be positive");
+    uses_gyro_ = config.config().points.gyro_flow ||
+                 (config.config().estimator.use_lines && config.config().lines.flow.gyro_flow);
+    requireParam(!uses_gyro_ || !imu_topic.empty(), pnh, "imu_topic",
+                 "is empty, but points.gyro_flow or lines.flow.gyro_flow needs the gyroscope");
 
     config_ = config.config();
     front_end_ = std::make_unique<alvio::FrontEnd>(config_);
@@ -44,13 +64,38 @@ class TrackerNodelet : public GuardedNodelet {
 
     frame_pub_ = pnh.advertise<SharedTrackedFrame>("frame", 10);
     status_sub_ = nh.subscribe(status_topic, 10, &TrackerNodelet::onStatus, this);
+    if (uses_gyro_)
+      imu_sub_ = nh.subscribe(imu_topic, 2000, &TrackerNodelet::onImu, this,
+                              ros::TransportHints().tcpNoDelay());
     transport_ = std::make_unique<image_transport::ImageTransport>(nh);
     image_sub_ = transport_->subscribe(
         image_topic, queue, &TrackerNodelet::onImage, this,
         image_transport::TransportHints(transport, ros::TransportHints(), pnh));
-    NODELET_INFO("tracking %s (%s) with %s; points%s; publishing %s", image_sub_.getTopic().c_str(),
-                 transport.c_str(), config.describe().c_str(),
-                 front_end_->tracksLines() ? " and lines" : " only", frame_pub_.getTopic().c_str());
+    const std::string gyro =
+        uses_gyro_ ? "flow from the gyroscope on " + imu_sub_.getTopic() : "no gyroscope";
+    NODELET_INFO("tracking %s (%s) with %s; points%s; %s; publishing %s",
+                 image_sub_.getTopic().c_str(), transport.c_str(), config.describe().c_str(),
+                 front_end_->tracksLines() ? " and lines" : " only", gyro.c_str(),
+                 frame_pub_.getTopic().c_str());
+  }
+
+  void onImu(const sensor_msgs::ImuConstPtr& msg) {
+    const alvio::ImuSample sample = fromMsg(*msg);
+    if (alvio::clockJumpedBack(sample.t_ns, newest_imu_ns_)) {
+      // A new run (a bag played again): images of the old clock still waiting are not part of it.
+      NODELET_WARN("IMU clock jumped back %.2f s: images waiting for the IMU are dropped",
+                   (newest_imu_ns_ - sample.t_ns) * 1e-9);
+      sync_ = Sync(sync_.options());
+      newest_imu_ns_ = sample.t_ns;
+    }
+    newest_imu_ns_ = std::max(newest_imu_ns_, sample.t_ns);
+    sync_.addImu(sample);
+    release();
+  }
+
+  // Track every image whose IMU has come, oldest first.
+  void release() {
+    while (std::optional<Sync::Ready> ready = sync_.pop()) track(ready->frame, ready->imu);
   }
 
   void onImage(const sensor_msgs::ImageConstPtr& image) {
@@ -77,6 +122,26 @@ class TrackerNodelet : public GuardedNodelet {
                              config_.camera.height);
       return;
     }
+    PendingImage pending{image, gray, received};
+    if (!uses_gyro_) {
+      track(pending, {});
+      return;
+    }
+    const std::size_t overflow_before = sync_.counts().frames_overflow;
+    if (!sync_.addFrame(toNs(image->header.stamp), std::move(pending)))
+      NODELET_WARN_THROTTLE(5.0, "image at %.3f s is not after the previous one: skipped",
+                            image->header.stamp.toSec());
+    if (sync_.counts().frames_overflow != overflow_before)
+      NODELET_WARN_THROTTLE(5.0,
+                            "%zu images waited for the IMU on %s (points.gyro_flow, "
+                            "lines.flow.gyro_flow): the oldest was dropped",
+                            sync_.options().max_frames, imu_sub_.getTopic().c_str());
+    release();
+  }
+
+  // `imu`: the samples that came since the previous image (none without the gyroscope's flow).
+  void track(const PendingImage& pending, const std::vector<alvio::ImuSample>& imu) {
+    const sensor_msgs::ImageConstPtr& image = pending.image;
     const int64_t t_ns = toNs(image->header.stamp);
     if (alvio::clockJumpedBack(t_ns, last_t_ns_)) {
       // A bag played again, a restarted simulation, a clock reset: a new run.
@@ -99,12 +164,14 @@ class TrackerNodelet : public GuardedNodelet {
       reset_pending_ = false;
     }
 
+    for (const alvio::ImuSample& s : imu) front_end_->addImu(s);
+
     alvio::FrameTiming timing;
     timing.t = t_ns * 1e-9;
-    const alvio::FeatureFrame frame = front_end_->track(gray->image, t_ns, &timing);
+    const alvio::FeatureFrame frame = front_end_->track(pending.gray->image, t_ns, &timing);
     auto out = boost::make_shared<SharedTrackedFrame>();
     toMsg(frame, timing, image->header, &out->features);
-    out->features.received = ros::Time(received.sec, received.nsec);
+    out->features.received = ros::Time(pending.received.sec, pending.received.nsec);
     out->image = image;  // the received pointer itself: no copy
     frame_pub_.publish(out);
   }
@@ -121,9 +188,11 @@ class TrackerNodelet : public GuardedNodelet {
   std::unique_ptr<alvio::FrontEnd> front_end_;
   std::unique_ptr<image_transport::ImageTransport> transport_;
   image_transport::Subscriber image_sub_;
-  ros::Subscriber status_sub_;
+  ros::Subscriber status_sub_, imu_sub_;
   ros::Publisher frame_pub_;
-  int64_t frame_period_ns_ = 50000000, last_t_ns_ = 0;
+  bool uses_gyro_ = false;
+  Sync sync_;
+  int64_t frame_period_ns_ = 50000000, last_t_ns_ = 0, newest_imu_ns_ = 0;
   int reset_count_ = 0;
   bool reset_pending_ = false;
 };

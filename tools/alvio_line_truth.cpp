@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <optional>
 
 #include "alvio/camera/camera_model.h"
 #include "alvio/common/arg_parser.h"
@@ -18,6 +19,7 @@
 #include "alvio/config/config.h"
 #include "alvio/eval/line_track_truth.h"
 #include "alvio/eval/trajectory_interpolation.h"
+#include "alvio/frontend/gyro_rotation.h"
 #include "alvio/io/euroc_dataset.h"
 #include "alvio/io/trajectory_io.h"
 #include "alvio/sim/edge_projection.h"
@@ -116,6 +118,11 @@ int main(int argc, char** argv) {
         trackers.push_back(createLineTracker(config.camera, options));
         scores.emplace_back(association);
       }
+      // The trackers get the gyroscope's rotation between the frames they see, as in the
+      // pipeline (lines.flow.gyro_flow).
+      GyroRotation gyro(config.camera.T_b_c.linear());
+      for (const ImuSample& s : dataset.imu()) gyro.add(s);
+      int64_t previous_ns = 0;
       double truth_ms = 0, visible_edges = 0;
       int used = 0;
       const auto& images = dataset.images();
@@ -135,8 +142,11 @@ int main(int argc, char** argv) {
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
                 .count();
         visible_edges += truth.size();
+        std::optional<Eigen::Matrix3d> R_cur_prev;
+        if (previous_ns) R_cur_prev = gyro.cameraRotation(previous_ns, images[k].t_ns);
+        previous_ns = images[k].t_ns;
         for (std::size_t i = 0; i < trackers.size(); ++i)
-          scores[i].addFrame(trackers[i]->track(image, t), truth);
+          scores[i].addFrame(trackers[i]->track(image, t, R_cur_prev), truth);
         ++used;
         if (used % 100 == 0) std::cerr << "\r" << dir << ": " << used << " frames" << std::flush;
       }

@@ -61,8 +61,43 @@ void PointTracker::rejectWithFundamental(std::vector<cv::Point2f>* prev,
   keep(counts, status);
 }
 
+void PointTracker::flowForwardBackward(const std::vector<cv::Mat>& prev_pyramid,
+                                       const std::vector<cv::Mat>& pyramid,
+                                       const std::vector<cv::Point2f>& from,
+                                       std::vector<cv::Point2f>* to, std::vector<uchar>* status,
+                                       int levels) const {
+  const cv::Size win(options_.klt_window, options_.klt_window);
+  const cv::TermCriteria stop(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 30, 0.01);
+  // No error output (cv::noArray()): KLT's residual per point goes unused, and computing it
+  // costs about a tenth of the tracking.
+  cv::calcOpticalFlowPyrLK(prev_pyramid, pyramid, from, *to, *status, cv::noArray(), win, levels,
+                           stop, to->empty() ? 0 : cv::OPTFLOW_USE_INITIAL_FLOW);
+  if (!options_.forward_backward_check) return;
+  std::vector<cv::Point2f> back = from;
+  std::vector<uchar> back_status;
+  cv::calcOpticalFlowPyrLK(pyramid, prev_pyramid, *to, back, back_status, cv::noArray(), win,
+                           levels, stop, cv::OPTFLOW_USE_INITIAL_FLOW);
+  for (std::size_t i = 0; i < status->size(); ++i)
+    (*status)[i] = (*status)[i] && back_status[i] &&
+                   cv::norm(back[i] - from[i]) <= options_.forward_backward_max_px;
+}
+
+std::vector<cv::Point2f> PointTracker::rotatedCorners(const Eigen::Matrix3d& R_cur_prev) const {
+  std::vector<cv::Point2f> moved(pts_.size());
+  for (std::size_t i = 0; i < pts_.size(); ++i) {
+    Eigen::Vector2d px;
+    // A corner turned behind the camera keeps its position: KLT will lose it either way.
+    if (camera_->project(R_cur_prev * camera_->backProject({pts_[i].x, pts_[i].y}), &px))
+      moved[i] = cv::Point2f(static_cast<float>(px.x()), static_cast<float>(px.y()));
+    else
+      moved[i] = pts_[i];
+  }
+  return moved;
+}
+
 FeatureFrame PointTracker::track(const cv::Mat& gray, int64_t t_ns, FrameTiming* timing,
-                                 double mean_intensity) {
+                                 double mean_intensity,
+                                 const std::optional<Eigen::Matrix3d>& R_cur_prev) {
   if (gray.type() != CV_8UC1)
     throw Error("point tracker: expected an 8-bit single-channel image, got type " +
                 std::to_string(gray.type()));
@@ -96,21 +131,31 @@ FeatureFrame PointTracker::track(const cv::Mat& gray, int64_t t_ns, FrameTiming*
     if (!prev_pyramid_.empty() && !pts_.empty()) {
       std::vector<cv::Point2f> next;
       std::vector<uchar> status;
-      // No error output (cv::noArray()): KLT's residual per point goes unused, and computing it
-      // costs about a tenth of the tracking.
-      cv::calcOpticalFlowPyrLK(prev_pyramid_, pyramid, pts_, next, status, cv::noArray(), win,
-                               options_.klt_levels);
-      if (options_.forward_backward_check) {
-        std::vector<cv::Point2f> back = pts_;
-        std::vector<uchar> back_status;
-        cv::calcOpticalFlowPyrLK(
-            pyramid, prev_pyramid_, next, back, back_status, cv::noArray(), win,
-            options_.klt_levels,
-            cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 30, 0.01),
-            cv::OPTFLOW_USE_INITIAL_FLOW);
+      // Started where the gyroscope's rotation puts them, corners need fewer levels. Those
+      // that fail there (a near surface's fast flow) try again on all levels.
+      const bool predicted = options_.gyro_flow && R_cur_prev.has_value();
+      if (predicted) {
+        const std::vector<cv::Point2f> predictions = rotatedCorners(*R_cur_prev);
+        next = predictions;
+        flowForwardBackward(prev_pyramid_, pyramid, pts_, &next, &status, options_.gyro_klt_levels);
+        std::vector<std::size_t> failed;
+        std::vector<cv::Point2f> from, to;
         for (std::size_t i = 0; i < status.size(); ++i)
-          status[i] = status[i] && back_status[i] &&
-                      cv::norm(back[i] - pts_[i]) <= options_.forward_backward_max_px;
+          if (!status[i]) {
+            failed.push_back(i);
+            from.push_back(pts_[i]);
+            to.push_back(predictions[i]);
+          }
+        if (!failed.empty() && options_.gyro_klt_levels < options_.klt_levels) {
+          std::vector<uchar> again;
+          flowForwardBackward(prev_pyramid_, pyramid, from, &to, &again, options_.klt_levels);
+          for (std::size_t k = 0; k < failed.size(); ++k) {
+            next[failed[k]] = to[k];
+            status[failed[k]] = again[k];
+          }
+        }
+      } else {
+        flowForwardBackward(prev_pyramid_, pyramid, pts_, &next, &status, options_.klt_levels);
       }
       for (std::size_t i = 0; i < status.size(); ++i)
         status[i] = status[i] && camera_->inImage({next[i].x, next[i].y}, 1.0);

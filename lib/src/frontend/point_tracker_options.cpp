@@ -19,6 +19,8 @@ PointTrackerOptions PointTrackerOptions::load(const YamlReader& yaml, const std:
   o.exposure_jump = yaml.getDouble(p + "exposure_jump", o.exposure_jump);
   o.klt_window = yaml.getInt(p + "klt_window", o.klt_window);
   o.klt_levels = yaml.getInt(p + "klt_levels", o.klt_levels);
+  o.gyro_flow = yaml.getBool(p + "gyro_flow", o.gyro_flow);
+  o.gyro_klt_levels = yaml.getInt(p + "gyro_klt_levels", o.gyro_klt_levels);
   o.forward_backward_check = yaml.getBool(p + "forward_backward_check", o.forward_backward_check);
   o.forward_backward_max_px =
       yaml.getDouble(p + "forward_backward_max_px", o.forward_backward_max_px);
@@ -50,6 +52,9 @@ PointTrackerOptions PointTrackerOptions::load(const YamlReader& yaml, const std:
     throw Error(yaml.where(p + "min_new_features") + " must be in [1, max_features]");
   if (o.klt_window < 5 || o.klt_window % 2 == 0)
     throw Error(yaml.where(p + "klt_window") + " must be an odd number >= 5");
+  if (o.klt_levels < 0) throw Error(yaml.where(p + "klt_levels") + " must not be negative");
+  if (o.gyro_klt_levels < 0)
+    throw Error(yaml.where(p + "gyro_klt_levels") + " must not be negative");
   return o;
 }
 

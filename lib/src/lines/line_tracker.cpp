@@ -22,16 +22,18 @@ LineTracker::LineTracker(const CameraOptions& camera, const LineTrackerOptions& 
   options_.validate("lines");
 }
 
-LineFrame LineTracker::track(const cv::Mat& gray, double t) {
+LineFrame LineTracker::track(const cv::Mat& gray, double t,
+                             const std::optional<Eigen::Matrix3d>& R_cur_prev) {
   const auto start = std::chrono::steady_clock::now();
   const cv::Mat undistorted = undistorter_.undistort(gray);
   const double undistort_ms = msSince(start);
-  LineFrame frame = trackUndistorted(undistorted, t);
+  LineFrame frame = trackUndistorted(undistorted, t, R_cur_prev);
   frame.stats.undistort_ms = undistort_ms;
   return frame;
 }
 
-LineFrame LineTracker::trackUndistorted(const cv::Mat& undistorted, double t) {
+LineFrame LineTracker::trackUndistorted(const cv::Mat& undistorted, double t,
+                                        const std::optional<Eigen::Matrix3d>& R_cur_prev) {
   if (undistorted.type() != CV_8UC1 || undistorted.size() != undistorter_.size())
     throw Error(std::string(name()) + ": expected an 8-bit grey image of the camera's size");
   LineFrame frame;
@@ -45,6 +47,7 @@ LineFrame LineTracker::trackUndistorted(const cv::Mat& undistorted, double t) {
     frame.stats.detected += s.length() >= detector_.minLength();
 
   start = std::chrono::steady_clock::now();
+  R_cur_prev_ = R_cur_prev;
   associate(undistorted, detections, detect, &frame);
   for (LineObservation& obs : frame.lines) {
     obs.start_norm = undistorter_.pixelToNormalised(obs.start_px);

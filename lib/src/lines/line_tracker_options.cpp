@@ -73,6 +73,8 @@ FlowLineTrackerOptions FlowLineTrackerOptions::load(const YamlReader& yaml,
   o.samples_per_line = yaml.getInt(p + "samples_per_line", o.samples_per_line);
   o.klt_window_px = yaml.getInt(p + "klt_window_px", o.klt_window_px);
   o.klt_pyramid_levels = yaml.getInt(p + "klt_pyramid_levels", o.klt_pyramid_levels);
+  o.gyro_flow = yaml.getBool(p + "gyro_flow", o.gyro_flow);
+  o.gyro_klt_levels = yaml.getInt(p + "gyro_klt_levels", o.gyro_klt_levels);
   o.klt_max_iterations = yaml.getInt(p + "klt_max_iterations", o.klt_max_iterations);
   o.klt_epsilon = yaml.getDouble(p + "klt_epsilon", o.klt_epsilon);
   o.knn = yaml.getInt(p + "knn", o.knn);
@@ -91,6 +93,7 @@ void FlowLineTrackerOptions::validate(const std::string& where) const {
   require(klt_window_px >= 5 && klt_window_px % 2 == 1, where, "klt_window_px", "odd and >= 5",
           klt_window_px);
   require(klt_pyramid_levels >= 0, where, "klt_pyramid_levels", "non-negative", klt_pyramid_levels);
+  require(gyro_klt_levels >= 0, where, "gyro_klt_levels", "non-negative", gyro_klt_levels);
   require(klt_max_iterations > 0, where, "klt_max_iterations", "positive", klt_max_iterations);
   require(klt_epsilon > 0, where, "klt_epsilon", "positive", klt_epsilon);
   require(knn >= 1, where, "knn", ">= 1", knn);

@@ -1,5 +1,6 @@
 #include "alvio/lines/optical_flow_line_tracker.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <opencv2/video/tracking.hpp>
@@ -147,22 +148,59 @@ void OpticalFlowLineTracker::predict(const std::vector<cv::Mat>& pyramid, cv::Si
   std::vector<cv::Point2f> moved;
   std::vector<uchar> status;
   const auto& f = options_.flow;
-  // Without KLT's error output, which nothing reads: about a tenth of the KLT time.
-  cv::calcOpticalFlowPyrLK(prev_pyramid_, pyramid, samples, moved, status, cv::noArray(),
-                           cv::Size(f.klt_window_px, f.klt_window_px), f.klt_pyramid_levels,
-                           cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS,
-                                            f.klt_max_iterations, f.klt_epsilon));
+  const cv::Size win(f.klt_window_px, f.klt_window_px);
+  const cv::TermCriteria stop(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, f.klt_max_iterations,
+                              f.klt_epsilon);
   // OpenCV fails a point whose window ended up wholly outside the image only while computing
-  // that error; fail it here instead (the same tracks as with the error).
+  // its error; fail it here instead (the same tracks as with the error).
   const float half = (f.klt_window_px - 1) * 0.5f;
-  auto outside = [&](float x, int size) {
-    const int corner = cvFloor(x - half);
-    return corner < -f.klt_window_px || corner >= size;
+  auto outside = [&](const cv::Point2f& p) {
+    auto off = [&](float x, int size) {
+      const int corner = cvFloor(x - half);
+      return corner < -f.klt_window_px || corner >= size;
+    };
+    return off(p.x, image_size.width) || off(p.y, image_size.height);
   };
-  for (std::size_t i = 0; i < moved.size(); ++i)
-    if (status[i] &&
-        (outside(moved[i].x, image_size.width) || outside(moved[i].y, image_size.height)))
-      status[i] = 0;
+  if (!usesRotation()) {
+    // Without KLT's error output, which nothing reads: about a tenth of the KLT time.
+    cv::calcOpticalFlowPyrLK(prev_pyramid_, pyramid, samples, moved, status, cv::noArray(), win,
+                             f.klt_pyramid_levels, stop);
+    for (std::size_t i = 0; i < moved.size(); ++i) status[i] = status[i] && !outside(moved[i]);
+  } else {
+    // Started where the gyroscope's rotation puts them (in the pinhole image the homography
+    // K R K^-1), samples need fewer levels; those that fail there try again on all levels.
+    const Eigen::Matrix3d& R = *rotationSincePrevious();
+    std::vector<cv::Point2f> predicted(samples.size());
+    for (std::size_t i = 0; i < samples.size(); ++i) {
+      const Eigen::Vector3d r =
+          R * undistorter().pixelToNormalised({samples[i].x, samples[i].y}).homogeneous();
+      predicted[i] = samples[i];  // turned behind the camera: KLT loses it either way
+      if (r.z() <= 0) continue;
+      const Eigen::Vector2d px = undistorter().normalisedToPixel(r.hnormalized());
+      predicted[i] = cv::Point2f(static_cast<float>(px.x()), static_cast<float>(px.y()));
+    }
+    moved = predicted;
+    cv::calcOpticalFlowPyrLK(prev_pyramid_, pyramid, samples, moved, status, cv::noArray(), win,
+                             f.gyro_klt_levels, stop, cv::OPTFLOW_USE_INITIAL_FLOW);
+    std::vector<std::size_t> failed;
+    std::vector<cv::Point2f> from, to;
+    for (std::size_t i = 0; i < moved.size(); ++i) {
+      status[i] = status[i] && !outside(moved[i]);
+      if (status[i]) continue;
+      failed.push_back(i);
+      from.push_back(samples[i]);
+      to.push_back(predicted[i]);
+    }
+    if (!failed.empty() && f.gyro_klt_levels < f.klt_pyramid_levels) {
+      std::vector<uchar> again;
+      cv::calcOpticalFlowPyrLK(prev_pyramid_, pyramid, from, to, again, cv::noArray(), win,
+                               f.klt_pyramid_levels, stop, cv::OPTFLOW_USE_INITIAL_FLOW);
+      for (std::size_t k = 0; k < failed.size(); ++k) {
+        moved[failed[k]] = to[k];
+        status[failed[k]] = again[k] && !outside(to[k]);
+      }
+    }
+  }
   for (std::size_t i = 0; i < tracks_.size(); ++i)
     predictions_[i].valid =
         predictOne(tracks_[i], moved, status, i * n, image_size, &predictions_[i]);

@@ -13,10 +13,14 @@ VioPipeline::VioPipeline(const Config& config)
 bool VioPipeline::addImu(const ImuSample& sample) {
   const int jumps_before = estimator_.clockJumps();
   estimator_.addImu(sample);
-  if (estimator_.clockJumps() == jumps_before) return false;
-  last_image_ns_ = 0;  // the next image starts the new clock
-  front_end_.resetPoints();
-  return true;
+  const bool jumped = estimator_.clockJumps() != jumps_before;
+  if (jumped) {
+    last_image_ns_ = 0;  // the next image starts the new clock
+    front_end_.resetPoints();
+    front_end_.clearImu();
+  }
+  front_end_.addImu(sample);
+  return jumped;
 }
 
 PipelineOutput VioPipeline::addImage(const cv::Mat& gray, int64_t t_ns,

@@ -6,6 +6,7 @@
 #include <memory>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -24,9 +25,11 @@ class PointTracker {
 
   /// Track into the next 8-bit grey image. Stage times go to `timing` when given.
   /// `mean_intensity`: the scene's mean brightness when the caller has measured it (before
-  /// exposure compensation); negative: measured here, on `gray`.
+  /// exposure compensation); negative: measured here, on `gray`. `R_cur_prev`: the camera's
+  /// rotation since the previous image (GyroRotation), where KLT starts when gyro_flow is on.
   FeatureFrame track(const cv::Mat& gray, int64_t t_ns, FrameTiming* timing = nullptr,
-                     double mean_intensity = -1);
+                     double mean_intensity = -1,
+                     const std::optional<Eigen::Matrix3d>& R_cur_prev = std::nullopt);
   /// Forget all tracks (after a reset, or an image-size change).
   void reset();
 
@@ -34,6 +37,14 @@ class PointTracker {
   void rejectWithFundamental(std::vector<cv::Point2f>* prev, std::vector<cv::Point2f>* cur,
                              std::vector<int>* ids, std::vector<int>* counts) const;
   void detectNew(const cv::Mat& img);
+  /// KLT from `from` in the previous pyramid to `to` in this one (started at `to` when it is
+  /// not empty) on `levels` levels, then back: a corner that does not return fails.
+  void flowForwardBackward(const std::vector<cv::Mat>& prev_pyramid,
+                           const std::vector<cv::Mat>& pyramid,
+                           const std::vector<cv::Point2f>& from, std::vector<cv::Point2f>* to,
+                           std::vector<uchar>* status, int levels) const;
+  /// Where the rotation R_cur_prev alone moves each tracked corner (distorted pixels).
+  std::vector<cv::Point2f> rotatedCorners(const Eigen::Matrix3d& R_cur_prev) const;
   void alignToAnchors(const cv::Mat& img);
 
   PointTrackerOptions options_;

@@ -13,6 +13,7 @@
 #include <Eigen/Core>
 #include <memory>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <vector>
 
 #include "alvio/config/sensor_options.h"
@@ -37,10 +38,13 @@ class LineTracker {
   LineTracker(const LineTracker&) = delete;
   LineTracker& operator=(const LineTracker&) = delete;
 
-  /// Process one raw (distorted) 8-bit grey image taken at time t [s].
-  LineFrame track(const cv::Mat& gray, double t);
+  /// Process one raw (distorted) 8-bit grey image taken at time t [s]. `R_cur_prev`: the
+  /// camera's rotation since the previous image (GyroRotation), for trackers that use it.
+  LineFrame track(const cv::Mat& gray, double t,
+                  const std::optional<Eigen::Matrix3d>& R_cur_prev = std::nullopt);
   /// Same, for an image already undistorted with undistorter() (to share the remap).
-  LineFrame trackUndistorted(const cv::Mat& undistorted, double t);
+  LineFrame trackUndistorted(const cv::Mat& undistorted, double t,
+                             const std::optional<Eigen::Matrix3d>& R_cur_prev = std::nullopt);
 
   const ImageUndistorter& undistorter() const { return undistorter_; }
   const LineTrackerOptions& options() const { return options_; }
@@ -55,6 +59,8 @@ class LineTracker {
   virtual void associate(const cv::Mat& undistorted, const std::vector<LineSegment>& detections,
                          bool detected, LineFrame* frame) = 0;
   const LineDetector& detector() const { return detector_; }
+  /// The rotation passed with the frame being associated.
+  const std::optional<Eigen::Matrix3d>& rotationSincePrevious() const { return R_cur_prev_; }
   int newId() { return next_id_++; }
   /// The unused detections that start new lines this frame: long enough for a new line,
   /// longest first, no more than leave room under max_lines after `tracked` lines.
@@ -66,6 +72,7 @@ class LineTracker {
  private:
   ImageUndistorter undistorter_;
   LineDetector detector_;
+  std::optional<Eigen::Matrix3d> R_cur_prev_;
   int next_id_ = 0;
 };
 

@@ -63,6 +63,11 @@ struct FlowLineTrackerOptions {
   int samples_per_line = 5;
   int klt_window_px = 15;
   int klt_pyramid_levels = 3;
+  /// Start the samples' KLT where the gyroscope's rotation since the last frame moves them
+  /// (when the caller passes that rotation), with gyro_klt_levels pyramid levels instead of
+  /// klt_pyramid_levels.
+  bool gyro_flow = true;
+  int gyro_klt_levels = 1;
   int klt_max_iterations = 30;
   double klt_epsilon = 0.01;
   /// Candidate detections kept per predicted line (the K of the KNN matching).

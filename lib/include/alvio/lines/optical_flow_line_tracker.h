@@ -53,6 +53,8 @@ class OpticalFlowLineTracker final : public LineTracker {
     int count;
   };
   void predict(const std::vector<cv::Mat>& pyramid, cv::Size image_size);
+  /// Whether this frame's flow starts from the gyroscope's rotation.
+  bool usesRotation() const { return options_.flow.gyro_flow && rotationSincePrevious(); }
   /// Steps 2 and 3: this frame's lines from the predictions and the detections.
   std::vector<Track> match(const std::vector<LineSegment>& detections, LineFrame* frame);
   /// A frame without detections: the valid predictions are this frame's lines.
