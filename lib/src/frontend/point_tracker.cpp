@@ -65,7 +65,7 @@ void PointTracker::flowForwardBackward(const std::vector<cv::Mat>& prev_pyramid,
                                        const std::vector<cv::Mat>& pyramid,
                                        const std::vector<cv::Point2f>& from,
                                        std::vector<cv::Point2f>* to, std::vector<uchar>* status,
-                                       int levels) const {
+                                       int levels, const Eigen::Matrix3d* R_cur_prev) const {
   const cv::Size win(options_.klt_window, options_.klt_window);
   const cv::TermCriteria stop(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 30, 0.01);
   // No error output (cv::noArray()): KLT's residual per point goes unused, and computing it
@@ -73,7 +73,10 @@ void PointTracker::flowForwardBackward(const std::vector<cv::Mat>& prev_pyramid,
   cv::calcOpticalFlowPyrLK(prev_pyramid, pyramid, from, *to, *status, cv::noArray(), win, levels,
                            stop, to->empty() ? 0 : cv::OPTFLOW_USE_INITIAL_FLOW);
   if (!options_.forward_backward_check) return;
-  std::vector<cv::Point2f> back = from;
+  // Back from where the rotation puts each arrival, not from the start itself: started there,
+  // a wrong arrival's way back would stay near the start on few levels, and pass.
+  std::vector<cv::Point2f> back =
+      R_cur_prev ? rotated(R_cur_prev->transpose(), *to) : std::vector<cv::Point2f>(from);
   std::vector<uchar> back_status;
   cv::calcOpticalFlowPyrLK(pyramid, prev_pyramid, *to, back, back_status, cv::noArray(), win,
                            levels, stop, cv::OPTFLOW_USE_INITIAL_FLOW);
@@ -82,15 +85,16 @@ void PointTracker::flowForwardBackward(const std::vector<cv::Mat>& prev_pyramid,
                    cv::norm(back[i] - from[i]) <= options_.forward_backward_max_px;
 }
 
-std::vector<cv::Point2f> PointTracker::rotatedCorners(const Eigen::Matrix3d& R_cur_prev) const {
-  std::vector<cv::Point2f> moved(pts_.size());
-  for (std::size_t i = 0; i < pts_.size(); ++i) {
-    Eigen::Vector2d px;
+std::vector<cv::Point2f> PointTracker::rotated(const Eigen::Matrix3d& R,
+                                               const std::vector<cv::Point2f>& px) const {
+  std::vector<cv::Point2f> moved(px.size());
+  for (std::size_t i = 0; i < px.size(); ++i) {
+    Eigen::Vector2d out;
     // A corner turned behind the camera keeps its position: KLT will lose it either way.
-    if (camera_->project(R_cur_prev * camera_->backProject({pts_[i].x, pts_[i].y}), &px))
-      moved[i] = cv::Point2f(static_cast<float>(px.x()), static_cast<float>(px.y()));
+    if (camera_->project(R * camera_->backProject({px[i].x, px[i].y}), &out))
+      moved[i] = cv::Point2f(static_cast<float>(out.x()), static_cast<float>(out.y()));
     else
-      moved[i] = pts_[i];
+      moved[i] = px[i];
   }
   return moved;
 }
@@ -135,9 +139,10 @@ FeatureFrame PointTracker::track(const cv::Mat& gray, int64_t t_ns, FrameTiming*
       // that fail there (a near surface's fast flow) try again on all levels.
       const bool predicted = options_.gyro_flow && R_cur_prev.has_value();
       if (predicted) {
-        const std::vector<cv::Point2f> predictions = rotatedCorners(*R_cur_prev);
+        const std::vector<cv::Point2f> predictions = rotated(*R_cur_prev, pts_);
         next = predictions;
-        flowForwardBackward(prev_pyramid_, pyramid, pts_, &next, &status, options_.gyro_klt_levels);
+        flowForwardBackward(prev_pyramid_, pyramid, pts_, &next, &status, options_.gyro_klt_levels,
+                            &*R_cur_prev);
         std::vector<std::size_t> failed;
         std::vector<cv::Point2f> from, to;
         for (std::size_t i = 0; i < status.size(); ++i)
@@ -148,7 +153,8 @@ FeatureFrame PointTracker::track(const cv::Mat& gray, int64_t t_ns, FrameTiming*
           }
         if (!failed.empty() && options_.gyro_klt_levels < options_.klt_levels) {
           std::vector<uchar> again;
-          flowForwardBackward(prev_pyramid_, pyramid, from, &to, &again, options_.klt_levels);
+          flowForwardBackward(prev_pyramid_, pyramid, from, &to, &again, options_.klt_levels,
+                              &*R_cur_prev);
           for (std::size_t k = 0; k < failed.size(); ++k) {
             next[failed[k]] = to[k];
             status[failed[k]] = again[k];

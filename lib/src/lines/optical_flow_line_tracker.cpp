@@ -182,24 +182,37 @@ void OpticalFlowLineTracker::predict(const std::vector<cv::Mat>& pyramid, cv::Si
     moved = predicted;
     cv::calcOpticalFlowPyrLK(prev_pyramid_, pyramid, samples, moved, status, cv::noArray(), win,
                              f.gyro_klt_levels, stop, cv::OPTFLOW_USE_INITIAL_FLOW);
-    std::vector<std::size_t> failed;
+    for (std::size_t i = 0; i < moved.size(); ++i) status[i] = status[i] && !outside(moved[i]);
+    // A line the few levels lost, or lost a sample of, tries again on all levels.
+    std::vector<std::size_t> again_lines;
+    for (std::size_t t = 0; t < tracks_.size(); ++t) {
+      predictions_[t].valid =
+          predictOne(tracks_[t], moved, status, t * n, image_size, &predictions_[t]);
+      const bool all_samples = std::all_of(status.begin() + t * n, status.begin() + (t + 1) * n,
+                                           [](uchar ok) { return ok != 0; });
+      if (!predictions_[t].valid || !all_samples) again_lines.push_back(t);
+    }
+    if (again_lines.empty() || f.gyro_klt_levels >= f.klt_pyramid_levels) return;
     std::vector<cv::Point2f> from, to;
-    for (std::size_t i = 0; i < moved.size(); ++i) {
-      status[i] = status[i] && !outside(moved[i]);
-      if (status[i]) continue;
-      failed.push_back(i);
-      from.push_back(samples[i]);
-      to.push_back(predicted[i]);
-    }
-    if (!failed.empty() && f.gyro_klt_levels < f.klt_pyramid_levels) {
-      std::vector<uchar> again;
-      cv::calcOpticalFlowPyrLK(prev_pyramid_, pyramid, from, to, again, cv::noArray(), win,
-                               f.klt_pyramid_levels, stop, cv::OPTFLOW_USE_INITIAL_FLOW);
-      for (std::size_t k = 0; k < failed.size(); ++k) {
-        moved[failed[k]] = to[k];
-        status[failed[k]] = again[k] && !outside(to[k]);
+    for (std::size_t t : again_lines)
+      for (int k = 0; k < n; ++k) {
+        from.push_back(samples[t * n + k]);
+        to.push_back(predicted[t * n + k]);
       }
+    std::vector<uchar> again;
+    cv::calcOpticalFlowPyrLK(prev_pyramid_, pyramid, from, to, again, cv::noArray(), win,
+                             f.klt_pyramid_levels, stop, cv::OPTFLOW_USE_INITIAL_FLOW);
+    for (std::size_t j = 0; j < again_lines.size(); ++j) {
+      const std::size_t t = again_lines[j];
+      for (int k = 0; k < n; ++k) {
+        moved[t * n + k] = to[j * n + k];
+        status[t * n + k] = again[j * n + k] && !outside(to[j * n + k]);
+      }
+      predictions_[t] = Prediction();
+      predictions_[t].valid =
+          predictOne(tracks_[t], moved, status, t * n, image_size, &predictions_[t]);
     }
+    return;
   }
   for (std::size_t i = 0; i < tracks_.size(); ++i)
     predictions_[i].valid =

@@ -38,13 +38,15 @@ class PointTracker {
                              std::vector<int>* ids, std::vector<int>* counts) const;
   void detectNew(const cv::Mat& img);
   /// KLT from `from` in the previous pyramid to `to` in this one (started at `to` when it is
-  /// not empty) on `levels` levels, then back: a corner that does not return fails.
+  /// not empty) on `levels` levels, then back: a corner that does not return fails. With the
+  /// camera's rotation the way back starts where that rotation puts each arrival.
   void flowForwardBackward(const std::vector<cv::Mat>& prev_pyramid,
-                           const std::vector<cv::Mat>& pyramid,
-                           const std::vector<cv::Point2f>& from, std::vector<cv::Point2f>* to,
-                           std::vector<uchar>* status, int levels) const;
-  /// Where the rotation R_cur_prev alone moves each tracked corner (distorted pixels).
-  std::vector<cv::Point2f> rotatedCorners(const Eigen::Matrix3d& R_cur_prev) const;
+                           const std::vector<cv::Mat>& pyramid, const std::vector<cv::Point2f>& from,
+                           std::vector<cv::Point2f>* to, std::vector<uchar>* status, int levels,
+                           const Eigen::Matrix3d* R_cur_prev = nullptr) const;
+  /// Where the rotation R alone moves each (distorted) pixel.
+  std::vector<cv::Point2f> rotated(const Eigen::Matrix3d& R,
+                                   const std::vector<cv::Point2f>& px) const;
   void alignToAnchors(const cv::Mat& img);
 
   PointTrackerOptions options_;
