@@ -136,6 +136,23 @@ TEST(Config, AnUnknownRobustLossIsRejectedByName) {
                         {"estimator.robust_loss", "must be cauchy, huber or none, not 'tukey'"});
 }
 
+TEST(Config, GyroscopeFlowSettingsAreReadAndNegativeLevelsRejectedByName) {
+  const Config c = Config::load(test::sourcePath("config/euroc.yaml"));
+  EXPECT_FALSE(c.points.gyro_flow);
+  EXPECT_TRUE(c.lines.flow.gyro_flow);
+  EXPECT_EQ(c.points.gyro_klt_levels, 1);
+  EXPECT_EQ(c.lines.flow.gyro_klt_levels, 1);
+  const std::string dir = test::scratchDir();
+  const std::string points =
+      test::writeFile(dir + "/points.yaml",
+                      eurocYamlReplacing("  gyro_klt_levels: 1\n", "  gyro_klt_levels: -1\n"));
+  expectErrorMentioning([&] { Config::load(points); },
+                        {"points.gyro_klt_levels", "must not be negative"});
+  const std::string lines = test::writeFile(
+      dir + "/lines.yaml", eurocYamlReplacing("    gyro_klt_levels: 1", "    gyro_klt_levels: -2"));
+  expectErrorMentioning([&] { Config::load(lines); }, {"gyro_klt_levels", "non-negative", "-2"});
+}
+
 TEST(Config, ClaheSettingsAreReadAndNonPositiveOnesAreRejected) {
   const Config c = Config::load(test::sourcePath("config/euroc.yaml"));
   EXPECT_DOUBLE_EQ(c.points.clahe_clip_limit, 3.0);

@@ -27,9 +27,10 @@ struct PointTrackerOptions {
   int klt_window = 21;
   int klt_levels = 3;
   /// Start KLT where the gyroscope's rotation since the last frame moves each corner (when the
-  /// caller passes that rotation), with gyro_klt_levels pyramid levels above the image instead
-  /// of klt_levels: only the translation's flow is left to search for.
-  bool gyro_flow = true;
+  /// caller passes that rotation), with gyro_klt_levels pyramid levels above the image; corners
+  /// that fail there try again on all klt_levels. Off by default: on one level the corners
+  /// err more in dim light (docs/benchmarks.md, thirty-first session).
+  bool gyro_flow = false;
   int gyro_klt_levels = 1;
   bool forward_backward_check = true;  ///< track back and reject points that do not return
   double forward_backward_max_px = 0.5;
