@@ -7,6 +7,7 @@
 #   scripts/ros_demo.sh [--rate R] [--out DIR]      (./alvio demo builds first)
 #   scripts/ros_demo.sh --bag FILE [--groundtruth TUM] [--record-status] [--no-logging] ...
 #   scripts/ros_demo.sh ... --allocator LIB   (preloaded into the manager; "" for glibc's malloc)
+#   scripts/ros_demo.sh ... --config FILE     (the nodelets' configuration; default config/euroc.yaml)
 #
 # The demo sequence comes from $ALVIO_DEMO_DATA, out/demo/sim, ../data/demo, or is
 # rendered with alvio_sim --demo when that tool is built. --bag plays another bag instead
@@ -25,6 +26,7 @@ gt=""
 record_status=false
 logging=true
 allocator=libmimalloc.so.2
+config="$ROOT/config/euroc.yaml"
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --rate) rate="$2"; shift 2 ;;
@@ -34,7 +36,8 @@ while [[ $# -gt 0 ]]; do
     --record-status) record_status=true; shift ;;
     --no-logging) logging=false; shift ;;
     --allocator) allocator="$2"; shift 2 ;;
-    -h|--help) sed -n '2,15p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --config) config="$(realpath "$2")"; shift 2 ;;
+    -h|--help) sed -n '2,16p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "demo: unknown option $1" >&2; exit 2 ;;
   esac
 done
@@ -84,7 +87,7 @@ fi
 log "playing $(basename "$bag") at rate $rate through the nodelet pipeline (master $ROS_MASTER_URI)"
 start=$(date +%s)
 roslaunch "$ROOT/launch/sim.launch" bag:="$bag" rate:="$rate" output_dir:="$run" logging:="$logging" \
-  allocator:="$allocator" exit_at_end:=false >"$out/roslaunch.log" 2>&1 &
+  allocator:="$allocator" config_file:="$config" exit_at_end:=false >"$out/roslaunch.log" 2>&1 &
 launch_pid=$!
 trap 'kill -INT "$launch_pid" ${record_pid:-} 2>/dev/null || true; kill "$core_pid" 2>/dev/null || true; wait 2>/dev/null || true' EXIT
 # The player appears, plays and leaves; then the estimator gets 1 s without frames to hand
