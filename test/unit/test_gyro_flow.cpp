@@ -119,7 +119,8 @@ TEST(PointTracker, TheGyroscopesRotationCarriesCornersThroughAFastTurn) {
   // Correct tracks in the second frame, of the corners the first frame found.
   auto correctTracks = [&](bool with_rotation) {
     PointTrackerOptions options = config.points;
-    options.klt_levels = 0;  // one level with or without the rotation
+    options.gyro_flow = true;  // off by default
+    options.klt_levels = 0;    // one level with or without the rotation
     options.gyro_klt_levels = 0;
     PointTracker tracker(options, camera);
     const FeatureFrame f1 = tracker.track(texture, 0);
@@ -160,6 +161,7 @@ TEST(OpticalFlowLineTracker, TheGyroscopesRotationCarriesLinesThroughAFastTurn) 
 
   auto keptLines = [&](bool with_rotation) {
     LineTrackerOptions options;
+    options.flow.gyro_flow = true;
     options.flow.detect_every = 1;
     options.flow.klt_pyramid_levels = 0;
     options.flow.gyro_klt_levels = 0;
