@@ -15,6 +15,7 @@
 #include <iostream>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 
 #include "alvio/camera/camera_model.h"
 #include "alvio/common/error.h"
@@ -24,6 +25,7 @@
 #include "alvio/estimator/factors/imu_factor.h"
 #include "alvio/estimator/factors/point_projection_factor.h"
 #include "alvio/frontend/corner_detector.h"
+#include "alvio/frontend/gyro_rotation.h"
 #include "alvio/frontend/min_eigen_response.h"
 #include "alvio/frontend/point_tracker.h"
 #include "alvio/geometry/line_projection_factor.h"
@@ -43,9 +45,11 @@ const Config& config() {
   return c;
 }
 
-// Two consecutive frames of the demo flight (mid-sequence, the camera moving).
+// Two consecutive frames of the demo flight (mid-sequence, the camera moving), and the
+// camera's rotation from a to b by the gyroscope (the line flow starts from it).
 struct FramePair {
   cv::Mat a, b;
+  std::optional<Eigen::Matrix3d> R_b_a;
 };
 
 const FramePair& framePair() {
@@ -62,8 +66,13 @@ const FramePair& framePair() {
     if (files.size() < 2) throw Error(images.string() + " has fewer than two images");
     const std::size_t k = files.size() / 2;
     FramePair p{cv::imread(files[k].string(), cv::IMREAD_GRAYSCALE),
-                cv::imread(files[k + 1].string(), cv::IMREAD_GRAYSCALE)};
+                cv::imread(files[k + 1].string(), cv::IMREAD_GRAYSCALE), std::nullopt};
     if (p.a.empty() || p.b.empty()) throw Error("cannot read " + files[k].string());
+    GyroRotation gyro(config().camera.T_b_c.linear());
+    for (const ImuSample& s : EurocDataset(dir.string()).imu()) gyro.add(s);
+    // EuRoC names each image by its time stamp in ns.
+    p.R_b_a = gyro.cameraRotation(std::stoll(files[k].stem().string()),
+                                  std::stoll(files[k + 1].stem().string()));
     return p;
   }();
   return pair;
@@ -118,7 +127,10 @@ void trackLines(benchmark::State& state, const std::string& kind, int detect_eve
   double tracked = 0;
   for (auto _ : state) {
     t += 0.05;
-    const LineFrame out = tracker->track(odd ? f.b : f.a, t);
+    // Back from b to a the camera turns the other way.
+    std::optional<Eigen::Matrix3d> R = f.R_b_a;
+    if (R && !odd) R = Eigen::Matrix3d(R->transpose());
+    const LineFrame out = tracker->track(odd ? f.b : f.a, t, R);
     odd = !odd;
     tracked = static_cast<double>(out.lines.size());
   }
