@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <iterator>
 
 #include "alvio/common/rotation.h"
 
@@ -21,9 +22,12 @@ std::optional<Eigen::Matrix3d> GyroRotation::cameraRotation(int64_t t0_ns, int64
     return (1.0 - s) * a.w + s * b.w;
   };
   Eigen::Quaterniond q_b0_b1 = Eigen::Quaterniond::Identity();
-  for (std::size_t i = 0; i + 1 < samples_.size(); ++i) {
-    const Rate& a = samples_[i];
-    const Rate& b = samples_[i + 1];
+  // From the last sample at or before t0 (a caller may keep a whole recording) to t1.
+  const auto first = std::partition_point(samples_.begin(), samples_.end(),
+                                          [&](const Rate& r) { return r.t_ns <= t0_ns; });
+  for (auto it = std::prev(first); std::next(it) != samples_.end() && it->t_ns < t1_ns; ++it) {
+    const Rate& a = *it;
+    const Rate& b = *std::next(it);
     const int64_t from = std::max(a.t_ns, t0_ns), to = std::min(b.t_ns, t1_ns);
     if (to <= from) continue;
     const Eigen::Vector3d w = 0.5 * (rateAt(a, b, from) + rateAt(a, b, to));
