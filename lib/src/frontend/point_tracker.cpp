@@ -73,8 +73,9 @@ void PointTracker::flowForwardBackward(const std::vector<cv::Mat>& prev_pyramid,
   cv::calcOpticalFlowPyrLK(prev_pyramid, pyramid, from, *to, *status, cv::noArray(), win, levels,
                            stop, to->empty() ? 0 : cv::OPTFLOW_USE_INITIAL_FLOW);
   if (!options_.forward_backward_check) return;
-  // Back from where the rotation puts each arrival, not from the start itself: started there,
-  // a wrong arrival's way back would stay near the start on few levels, and pass.
+  // Back from where the rotation puts each arrival rather than from the start itself, so that
+  // a wrong arrival's way back is not handed the right answer. Measured, it let about as many
+  // wrong arrivals through (dim light, one level: 4.65 % of corners over 3 px against 4.58 %).
   std::vector<cv::Point2f> back =
       R_cur_prev ? rotated(R_cur_prev->transpose(), *to) : std::vector<cv::Point2f>(from);
   std::vector<uchar> back_status;
