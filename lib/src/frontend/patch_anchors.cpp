@@ -101,6 +101,15 @@ bool PatchAnchors::anchor(int id, const cv::Mat& image, const cv::Point2f& p) {
         H.topLeftCorner(k_params_, k_params_).inverse();
   }
   patch.norm = static_cast<float>(std::sqrt(ss));
+  if (k_params_ > 2) {
+    patch.packed.assign(std::size_t(n) * n * 8, 0.0f);
+    for (int k = 0; k < n * n; ++k) {
+      float* block = &patch.packed[std::size_t(k) * 8];
+      block[0] = 1.0f;
+      block[1] = patch.values[k];
+      for (int i = 0; i < k_params_; ++i) block[2 + i] = patch.sd[i][k];
+    }
+  }
   patches_[id] = std::move(patch);
   return true;
 }
@@ -172,25 +181,24 @@ Alignment PatchAnchors::refineShift(Patch& t, const cv::Mat& image, cv::Point2f*
 
 namespace {
 // One pass over the warped patch (x' = A x + q, x the template offset): the sums every step
-// needs, for the first K steepest-descent images.
-template <int K>
+// needs. `packed` holds per pixel {1, value, sd[0..5]}: sums[0] is the samples' sum, sums[1]
+// their product with the template, sums[2..7] with the steepest-descent images.
 void warpedSums(const cv::Mat& image, const Eigen::Matrix2d& A, double qx, double qy, int n,
-                const float* values, const std::array<std::vector<float>, 6>& sd, float* s1,
-                float* s2, float* st, float* sg) {
+                const float* packed, float* s2, float* sums) {
   const int h = n / 2;
   const float a00 = static_cast<float>(A(0, 0)), a01 = static_cast<float>(A(0, 1));
   const float a10 = static_cast<float>(A(1, 0)), a11 = static_cast<float>(A(1, 1));
   const uchar* data = image.data;
   const std::size_t step = image.step[0];
-  float g[K] = {};
-  float sum = 0, sum2 = 0, cross = 0;
+  float acc[8] = {};
+  float sum2 = 0;
+  const float* block = packed;
   for (int r = 0; r < n; ++r) {
     const float y = static_cast<float>(r - h);
     // Along a row the sample moves by A's first column per pixel.
     float u = static_cast<float>(qx) - a00 * h + a01 * y;
     float v = static_cast<float>(qy) - a10 * h + a11 * y;
-    const int row = r * n;
-    for (int c = 0; c < n; ++c, u += a00, v += a10) {
+    for (int c = 0; c < n; ++c, u += a00, v += a10, block += 8) {
       const int iu = static_cast<int>(u), iv = static_cast<int>(v);
       const float fx = u - iu, fy = v - iv;
       const uchar* row0 = data + iv * step + iu;
@@ -198,16 +206,12 @@ void warpedSums(const cv::Mat& image, const Eigen::Matrix2d& A, double qx, doubl
       const float top = row0[0] + fx * (row0[1] - row0[0]);
       const float bottom = row1[0] + fx * (row1[1] - row1[0]);
       const float val = top + fy * (bottom - top);
-      sum += val;
       sum2 += val * val;
-      cross += val * values[row + c];
-      for (int i = 0; i < K; ++i) g[i] += val * sd[i][row + c];
+      for (int i = 0; i < 8; ++i) acc[i] += val * block[i];
     }
   }
-  *s1 = sum;
   *s2 = sum2;
-  *st = cross;
-  for (int i = 0; i < K; ++i) sg[i] = g[i];
+  for (int i = 0; i < 8; ++i) sums[i] = acc[i];
 }
 
 // The linear part of a warp step d (similarity: scale, rotation; affine: four entries).
@@ -233,11 +237,10 @@ Alignment PatchAnchors::refineWarp(Patch& t, const cv::Mat& image, cv::Point2f* 
         inside &= u >= 0 && v >= 0 && u < image.cols - 1.01 && v < image.rows - 1.01;
       }
     if (!inside) return Alignment::kOutside;  // also NaN
-    float s1 = 0, s2 = 0, st = 0, sg[6] = {};
-    if (k_params_ == 4)
-      warpedSums<4>(image, A, qx, qy, n, t.values.data(), t.sd, &s1, &s2, &st, sg);
-    else
-      warpedSums<6>(image, A, qx, qy, n, t.values.data(), t.sd, &s1, &s2, &st, sg);
+    float s2 = 0, sums[8];
+    warpedSums(image, A, qx, qy, n, t.packed.data(), &s2, sums);
+    const float s1 = sums[0], st = sums[1];
+    const float* sg = sums + 2;
     const double mean = s1 / count;
     const double ss = s2 - count * mean * mean;
     if (!(ss > 0)) return Alignment::kMismatch;

@@ -74,6 +74,10 @@ class PatchAnchors {
     /// x- and y-shift, then the linear part's parameters (similarity: scale, rotation;
     /// affine: its four entries) about the patch centre.
     std::array<std::vector<float>, 6> sd;
+    /// For the warps: per pixel 8 floats {1, value, sd[0..5]} (unused ones 0), so that one
+    /// pass multiplies a warped sample into all its sums at once, each sum still added up in
+    /// pixel order.
+    std::vector<float> packed;
     float norm = 0;                                   ///< sqrt(sum of values^2)
     Eigen::Matrix<double, 6, 1> sum_sd, sum_sd_t;     ///< sums of sd, and of sd times the values
     Eigen::Matrix2d inv_h2;                           ///< inverse Gauss-Newton matrix, shift alone
