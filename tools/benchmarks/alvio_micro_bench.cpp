@@ -69,7 +69,9 @@ const FramePair& framePair() {
                 cv::imread(files[k + 1].string(), cv::IMREAD_GRAYSCALE), std::nullopt};
     if (p.a.empty() || p.b.empty()) throw Error("cannot read " + files[k].string());
     GyroRotation gyro(config().camera.T_b_c.linear());
-    for (const ImuSample& s : EurocDataset(dir.string()).imu()) gyro.add(s);
+    // Named: a range-for over a temporary's member reference would read freed memory.
+    const EurocDataset dataset(dir.string());
+    for (const ImuSample& s : dataset.imu()) gyro.add(s);
     // EuRoC names each image by its time stamp in ns.
     p.R_b_a = gyro.cameraRotation(std::stoll(files[k].stem().string()),
                                   std::stoll(files[k + 1].stem().string()));
