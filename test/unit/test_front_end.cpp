@@ -1,8 +1,10 @@
 // The front end: lines tracked in their own thread give exactly the frames of the one-thread
-// front end; the point tracker looks for new corners only once enough are missing.
+// front end; the point tracker looks for new corners only once enough are missing, and tracks
+// back only the corners whose anchored patch did not align when asked to.
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <map>
 #include <opencv2/imgproc.hpp>
 
 #include "alvio/camera/camera_model.h"
@@ -93,6 +95,77 @@ TEST(PointTracker, NewCornersWaitUntilEnoughAreMissing) {
     EXPECT_GE(large_gaps, 1);
     if (min_new > 1) {
       EXPECT_GE(small_gaps, 1);
+    }
+  }
+}
+
+TEST(PointTracker, AlignedCornersSkipTheBackwardCheckAndOccludedOnesStillEnd) {
+  const Config config = Config::load(test::sourcePath("config/euroc.yaml"));
+  const std::shared_ptr<const CameraModel> camera = CameraModel::create(config.camera);
+  const int w = config.camera.width, h = config.camera.height;
+  cv::Mat texture(h, w + 400, CV_8UC1), other(h, w, CV_8UC1);
+  cv::RNG rng(11);
+  for (cv::Mat* m : {&texture, &other}) {
+    rng.fill(*m, cv::RNG::UNIFORM, 0, 255);
+    cv::GaussianBlur(*m, *m, cv::Size(0, 0), 3.0);
+    cv::normalize(*m, *m, 0, 255, cv::NORM_MINMAX);
+  }
+  // The content slides right by `shift` pixels.
+  const auto view = [&](int shift) { return texture(cv::Rect(400 - shift, 0, w, h)).clone(); };
+  // In the last frame an unrelated surface covers the image's left third.
+  const cv::Rect occluder(0, 0, w / 3, h);
+  const std::vector<int> shifts = {0, 3, 6, 9, 12, 15};
+  for (const bool skip : {false, true}) {
+    SCOPED_TRACE(skip ? "skipping the aligned corners' backward check" : "checking all corners");
+    PointTrackerOptions options = config.points;
+    options.gyro_flow = false;
+    options.anchors.enabled = true;
+    options.anchors.skip_backward_when_aligned = skip;
+    PointTracker tracker(options, camera);
+    std::map<int, Eigen::Vector2d> first;  // each corner's position where it was found
+    std::map<int, int> found_at;           // and the shift then
+    for (std::size_t f = 0; f < shifts.size(); ++f) {
+      cv::Mat image = view(shifts[f]);
+      const bool occluded = f + 1 == shifts.size();
+      if (occluded) other(occluder).copyTo(image(occluder));
+      const FeatureFrame frame = tracker.track(image, static_cast<int64_t>(f) * 50'000'000);
+      std::size_t old_tracks = 0, in_occluder = 0;
+      std::vector<double> errors;
+      for (const PointObservation& o : frame.points) {
+        if (!first.count(o.id)) {
+          first[o.id] = o.px;
+          found_at[o.id] = shifts[f];
+          continue;
+        }
+        ++old_tracks;
+        const Eigen::Vector2d truth =
+            first[o.id] + Eigen::Vector2d(shifts[f] - found_at[o.id], 0.0);
+        if (occluded && occluder.contains(cv::Point(cvRound(truth.x()), cvRound(truth.y())))) {
+          ++in_occluder;
+          continue;
+        }
+        // A patch the occluder's edge cuts into may still align, about a pixel off.
+        if (occluded && truth.x() < occluder.br().x + options.klt_window / 2 + 1) continue;
+        const double error = (o.px - truth).norm();
+        // A wrong arrival lands pixels away; near the border, where no patch fits, KLT alone
+        // errs by tenths of a pixel.
+        EXPECT_LT(error, 1.0) << "corner " << o.id << " in frame " << f;
+        errors.push_back(error);
+      }
+      if (f == 0) continue;
+      ASSERT_GT(old_tracks, occluded ? 50u : 100u);
+      // No corner whose surface the occluder hides goes on, checked back or not.
+      if (occluded) {
+        EXPECT_EQ(in_occluder, 0u);
+      }
+      std::nth_element(errors.begin(), errors.begin() + errors.size() / 2, errors.end());
+      EXPECT_LT(errors[errors.size() / 2], 0.05) << "median error in frame " << f;
+      if (!skip) {
+        EXPECT_GE(tracker.lastBackwardChecks(), old_tracks);
+      } else if (!occluded) {
+        EXPECT_LE(tracker.lastBackwardChecks(), old_tracks / 10)
+            << "corners whose patch aligned are not tracked back";
+      }
     }
   }
 }

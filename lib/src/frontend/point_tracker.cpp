@@ -61,29 +61,45 @@ void PointTracker::rejectWithFundamental(std::vector<cv::Point2f>* prev,
   keep(counts, status);
 }
 
-void PointTracker::flowForwardBackward(const std::vector<cv::Mat>& prev_pyramid,
-                                       const std::vector<cv::Mat>& pyramid,
-                                       const std::vector<cv::Point2f>& from,
-                                       std::vector<cv::Point2f>* to, std::vector<uchar>* status,
-                                       int levels, const Eigen::Matrix3d* R_cur_prev) const {
+void PointTracker::flow(const std::vector<cv::Mat>& from_pyramid,
+                        const std::vector<cv::Mat>& to_pyramid,
+                        const std::vector<cv::Point2f>& from, std::vector<cv::Point2f>* to,
+                        std::vector<uchar>* status, int levels) const {
   const cv::Size win(options_.klt_window, options_.klt_window);
   const cv::TermCriteria stop(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 30, 0.01);
   // No error output (cv::noArray()): KLT's residual per point goes unused, and computing it
   // costs about a tenth of the tracking.
-  cv::calcOpticalFlowPyrLK(prev_pyramid, pyramid, from, *to, *status, cv::noArray(), win, levels,
+  cv::calcOpticalFlowPyrLK(from_pyramid, to_pyramid, from, *to, *status, cv::noArray(), win, levels,
                            stop, to->empty() ? 0 : cv::OPTFLOW_USE_INITIAL_FLOW);
+}
+
+std::vector<uchar> PointTracker::returns(const std::vector<cv::Mat>& prev_pyramid,
+                                         const std::vector<cv::Mat>& pyramid,
+                                         const std::vector<cv::Point2f>& arrivals,
+                                         const std::vector<cv::Point2f>& origins,
+                                         std::vector<cv::Point2f> back, int levels) {
+  backward_checks_ += arrivals.size();
+  std::vector<uchar> status;
+  flow(pyramid, prev_pyramid, arrivals, &back, &status, levels);
+  for (std::size_t i = 0; i < status.size(); ++i)
+    status[i] = status[i] && cv::norm(back[i] - origins[i]) <= options_.forward_backward_max_px;
+  return status;
+}
+
+void PointTracker::flowForwardBackward(const std::vector<cv::Mat>& prev_pyramid,
+                                       const std::vector<cv::Mat>& pyramid,
+                                       const std::vector<cv::Point2f>& from,
+                                       std::vector<cv::Point2f>* to, std::vector<uchar>* status,
+                                       int levels, const Eigen::Matrix3d* R_cur_prev) {
+  flow(prev_pyramid, pyramid, from, to, status, levels);
   if (!options_.forward_backward_check) return;
   // Back from where the rotation puts each arrival rather than from the start itself, so that
   // a wrong arrival's way back is not handed the right answer. Measured, it let about as many
   // wrong arrivals through (dim light, one level: 4.65 % of corners over 3 px against 4.58 %).
-  std::vector<cv::Point2f> back =
-      R_cur_prev ? rotated(R_cur_prev->transpose(), *to) : std::vector<cv::Point2f>(from);
-  std::vector<uchar> back_status;
-  cv::calcOpticalFlowPyrLK(pyramid, prev_pyramid, *to, back, back_status, cv::noArray(), win,
-                           levels, stop, cv::OPTFLOW_USE_INITIAL_FLOW);
-  for (std::size_t i = 0; i < status->size(); ++i)
-    (*status)[i] = (*status)[i] && back_status[i] &&
-                   cv::norm(back[i] - from[i]) <= options_.forward_backward_max_px;
+  const std::vector<uchar> back =
+      returns(prev_pyramid, pyramid, *to, from,
+              R_cur_prev ? rotated(R_cur_prev->transpose(), *to) : from, levels);
+  for (std::size_t i = 0; i < status->size(); ++i) (*status)[i] = (*status)[i] && back[i];
 }
 
 std::vector<cv::Point2f> PointTracker::rotated(const Eigen::Matrix3d& R,
@@ -112,6 +128,7 @@ FeatureFrame PointTracker::track(const cv::Mat& gray, int64_t t_ns, FrameTiming*
                 std::to_string(camera_->width()) + "x" + std::to_string(camera_->height()));
   FeatureFrame frame;
   frame.t_ns = t_ns;
+  backward_checks_ = 0;
   frame.mean_intensity = mean_intensity >= 0 ? mean_intensity : cv::mean(gray)[0];
 
   cv::Mat img;
@@ -139,7 +156,12 @@ FeatureFrame PointTracker::track(const cv::Mat& gray, int64_t t_ns, FrameTiming*
       // Started where the gyroscope's rotation puts them, corners need fewer levels. Those
       // that fail there (a near surface's fast flow) try again on all levels.
       const bool predicted = options_.gyro_flow && R_cur_prev.has_value();
-      if (predicted) {
+      const bool aligned_first = !predicted && options_.anchors.enabled &&
+                                 options_.anchors.skip_backward_when_aligned &&
+                                 options_.forward_backward_check;
+      if (aligned_first) {
+        trackAlignedFirst(pyramid, img);
+      } else if (predicted) {
         const std::vector<cv::Point2f> predictions = rotated(*R_cur_prev, pts_);
         next = predictions;
         flowForwardBackward(prev_pyramid_, pyramid, pts_, &next, &status, options_.gyro_klt_levels,
@@ -164,16 +186,18 @@ FeatureFrame PointTracker::track(const cv::Mat& gray, int64_t t_ns, FrameTiming*
       } else {
         flowForwardBackward(prev_pyramid_, pyramid, pts_, &next, &status, options_.klt_levels);
       }
-      for (std::size_t i = 0; i < status.size(); ++i)
-        status[i] = status[i] && camera_->inImage({next[i].x, next[i].y}, 1.0);
-      std::vector<cv::Point2f> prev = pts_;
-      keep(&prev, status);
-      keep(&next, status);
-      keep(&ids_, status);
-      keep(&track_counts_, status);
-      rejectWithFundamental(&prev, &next, &ids_, &track_counts_);
-      pts_ = next;
-      if (options_.anchors.enabled) alignToAnchors(img);
+      if (!aligned_first) {
+        for (std::size_t i = 0; i < status.size(); ++i)
+          status[i] = status[i] && camera_->inImage({next[i].x, next[i].y}, 1.0);
+        std::vector<cv::Point2f> prev = pts_;
+        keep(&prev, status);
+        keep(&next, status);
+        keep(&ids_, status);
+        keep(&track_counts_, status);
+        rejectWithFundamental(&prev, &next, &ids_, &track_counts_);
+        pts_ = next;
+        if (options_.anchors.enabled) alignToAnchors(img);
+      }
     } else {
       pts_.clear();
       ids_.clear();
@@ -235,6 +259,60 @@ void PointTracker::alignToAnchors(const cv::Mat& img) {
   keep(&pts_, keep_track);
   keep(&ids_, keep_track);
   keep(&track_counts_, keep_track);
+}
+
+void PointTracker::trackAlignedFirst(const std::vector<cv::Mat>& pyramid, const cv::Mat& img) {
+  std::vector<cv::Point2f> next;
+  std::vector<uchar> status;
+  flow(prev_pyramid_, pyramid, pts_, &next, &status, options_.klt_levels);
+  anchors_.tick();
+  std::vector<uchar> aligned(pts_.size(), 0);
+  std::vector<std::size_t> unchecked;
+  std::vector<Alignment> outcome;  // of each unchecked corner's alignment
+  std::vector<cv::Point2f> arrivals, origins;
+  for (std::size_t i = 0; i < pts_.size(); ++i) {
+    if (!status[i] || !camera_->inImage({next[i].x, next[i].y}, 1.0)) {
+      status[i] = 0;
+      continue;
+    }
+    const cv::Point2f arrival = next[i];
+    const Alignment a = anchors_.refine(ids_[i], img, &next[i]);
+    if (a == Alignment::kAligned) {
+      aligned[i] = 1;
+      continue;
+    }
+    if (a == Alignment::kMismatch && options_.anchors.end_mismatched) {
+      status[i] = 0;
+      continue;
+    }
+    unchecked.push_back(i);
+    outcome.push_back(a);
+    arrivals.push_back(arrival);
+    origins.push_back(pts_[i]);
+  }
+  if (!unchecked.empty()) {
+    const std::vector<uchar> back =
+        returns(prev_pyramid_, pyramid, arrivals, origins, origins, options_.klt_levels);
+    for (std::size_t k = 0; k < unchecked.size(); ++k) {
+      const std::size_t i = unchecked[k];
+      if (!back[k]) {
+        status[i] = 0;
+        continue;
+      }
+      // As alignToAnchors: a patch that did not align is taken again where KLT is; one
+      // reaching out of the image keeps waiting.
+      if (outcome[k] != Alignment::kOutside) anchors_.anchor(ids_[i], img, next[i]);
+    }
+  }
+  for (std::size_t i = 0; i < pts_.size(); ++i)
+    if (aligned[i] && anchors_.dueForReanchor(ids_[i])) anchors_.anchor(ids_[i], img, next[i]);
+  std::vector<cv::Point2f> prev = pts_;
+  keep(&prev, status);
+  keep(&next, status);
+  keep(&ids_, status);
+  keep(&track_counts_, status);
+  rejectWithFundamental(&prev, &next, &ids_, &track_counts_);
+  pts_ = next;
 }
 
 void PointTracker::detectNew(const cv::Mat& img) {

@@ -47,6 +47,10 @@ struct PatchAnchorOptions {
   /// corner on an occluding edge (the background sliding behind it) is no 3D point, and its
   /// patch changes while a surface point's only warps. An unconfirmed patch is taken again.
   bool end_mismatched = true;
+  /// KLT's backward check only for tracks whose patch did not align: an arrival that
+  /// aligned to the track's first patch (ZNCC >= min_zncc, within max_shift_px) is taken as
+  /// checked. Needs forward_backward_check; not with the corners' gyroscope flow.
+  bool skip_backward_when_aligned = false;
 };
 
 class PatchAnchors {

@@ -32,22 +32,40 @@ class PointTracker {
                      const std::optional<Eigen::Matrix3d>& R_cur_prev = std::nullopt);
   /// Forget all tracks (after a reset, or an image-size change).
   void reset();
+  /// How many corners the last frame tracked back for the forward-backward check.
+  std::size_t lastBackwardChecks() const { return backward_checks_; }
 
  private:
   void rejectWithFundamental(std::vector<cv::Point2f>* prev, std::vector<cv::Point2f>* cur,
                              std::vector<int>* ids, std::vector<int>* counts) const;
   void detectNew(const cv::Mat& img);
+  /// KLT from `from` in `from_pyramid` to `to` in `to_pyramid` (started at `to` when it is
+  /// not empty) on `levels` levels.
+  void flow(const std::vector<cv::Mat>& from_pyramid, const std::vector<cv::Mat>& to_pyramid,
+            const std::vector<cv::Point2f>& from, std::vector<cv::Point2f>* to,
+            std::vector<uchar>* status, int levels) const;
+  /// The forward-backward check: KLT back from each arrival in this frame, started at `back`;
+  /// true where it comes within forward_backward_max_px of its origin.
+  std::vector<uchar> returns(const std::vector<cv::Mat>& prev_pyramid,
+                             const std::vector<cv::Mat>& pyramid,
+                             const std::vector<cv::Point2f>& arrivals,
+                             const std::vector<cv::Point2f>& origins, std::vector<cv::Point2f> back,
+                             int levels);
   /// KLT from `from` in the previous pyramid to `to` in this one (started at `to` when it is
   /// not empty) on `levels` levels, then back: a corner that does not return fails. With the
   /// camera's rotation the way back starts where that rotation puts each arrival.
   void flowForwardBackward(const std::vector<cv::Mat>& prev_pyramid,
-                           const std::vector<cv::Mat>& pyramid, const std::vector<cv::Point2f>& from,
-                           std::vector<cv::Point2f>* to, std::vector<uchar>* status, int levels,
-                           const Eigen::Matrix3d* R_cur_prev = nullptr) const;
+                           const std::vector<cv::Mat>& pyramid,
+                           const std::vector<cv::Point2f>& from, std::vector<cv::Point2f>* to,
+                           std::vector<uchar>* status, int levels,
+                           const Eigen::Matrix3d* R_cur_prev = nullptr);
   /// Where the rotation R alone moves each (distorted) pixel.
   std::vector<cv::Point2f> rotated(const Eigen::Matrix3d& R,
                                    const std::vector<cv::Point2f>& px) const;
   void alignToAnchors(const cv::Mat& img);
+  /// KLT forward, each arrival aligned to its anchored patch, and only the arrivals no patch
+  /// vouches for tracked back (anchors.skip_backward_when_aligned). Updates the tracks.
+  void trackAlignedFirst(const std::vector<cv::Mat>& pyramid, const cv::Mat& img);
 
   PointTrackerOptions options_;
   std::shared_ptr<const CameraModel> camera_;
@@ -61,6 +79,7 @@ class PointTracker {
   std::vector<Eigen::Vector2d> prev_xy_;  // by index into pts_ of the previous frame
   std::vector<int> prev_ids_;
   int next_id_ = 0;
+  std::size_t backward_checks_ = 0;
 };
 
 }  // namespace alvio
