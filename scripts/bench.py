@@ -27,6 +27,7 @@ repeats) with its range, and --compare the ratio of each seed's pair.
 import argparse
 import csv
 import json
+import math
 import os
 import shlex
 import shutil
@@ -348,6 +349,39 @@ def paired_ratios(per_run, seq, a, b):
             if v == a and (b, s, k) in ates]
 
 
+# Two-sided 95 % quantiles of Student's t for 1..30 degrees of freedom; 1.96 beyond.
+T95 = [12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262, 2.228, 2.201, 2.179,
+       2.160, 2.145, 2.131, 2.120, 2.110, 2.101, 2.093, 2.086, 2.080, 2.074, 2.069, 2.064, 2.060,
+       2.056, 2.052, 2.048, 2.045, 2.042]
+
+
+def pooled_ratio(ratios):
+    """Geometric mean of B/A ratios with its 95 % interval (t on the log ratios), or None for
+    fewer than two. A change whose interval holds 1 is not told apart from the runs' noise:
+    one seed's trajectory can move by 20 % from any small change (docs/benchmarks.md)."""
+    logs = [math.log(r) for r in ratios if r is not None and r > 0]
+    n = len(logs)
+    if n < 2:
+        return None
+    mean = sum(logs) / n
+    sd = math.sqrt(sum((x - mean) ** 2 for x in logs) / (n - 1))
+    half = (T95[n - 2] if n - 1 <= len(T95) else 1.96) * sd / math.sqrt(n)
+    return math.exp(mean), math.exp(mean - half), math.exp(mean + half), n
+
+
+def pooled_line(per_run, a, b):
+    """The compare table's last line: every paired run's B/A ATE ratio, pooled."""
+    ratios = [x for seq in dict.fromkeys(r["sequence"] for r in per_run)
+              for x in paired_ratios(per_run, seq, a, b) if x is not None]
+    pooled = pooled_ratio(ratios)
+    if pooled is None:
+        return ""
+    g, lo, hi, n = pooled
+    better = sum(x < 1 for x in ratios)
+    return (f"All {n} paired runs: ATE ratio {b}/{a} {g:.3f} (geometric mean; 95 % interval "
+            f"{lo:.3f}–{hi:.3f}); {better} of {n} runs lower with {b}.")
+
+
 def compare_table(results, a, b, per_run=None):
     """Ratios B/A. With per_run from several seeds, also each seed's ATE ratio."""
     seeds = sorted({r.get("seed", 1) for r in per_run or []})
@@ -368,7 +402,8 @@ def compare_table(results, a, b, per_run=None):
             f"{fmt(ratio(stage(ra, 'total'), stage(rb, 'total')), '.3f')} "
             f"| {fmt(ratio(ra.get('opt_total_median'), rb.get('opt_total_median')), '.3f')} "
             f"| {fmt(ratio(ra.get('peak_rss_mb'), rb.get('peak_rss_mb')), '.3f')} |")
-    return "\n".join(lines)
+    pooled = pooled_line(per_run or [], a, b)
+    return "\n".join(lines) + (f"\n\n{pooled}" if pooled else "")
 
 
 def ablation_table(results, seq):

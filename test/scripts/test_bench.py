@@ -213,6 +213,30 @@ class TablesTest(unittest.TestCase):
         self.assertEqual(rows[0], ["s1", "0.2000", "0.1000", "0.500", "1.250", "1.250", "1.500"])
         self.assertEqual(rows[1], ["s2", "0.3000", "–", "–", "–", "–", "–"])
 
+    def test_compare_table_pools_the_paired_runs(self):
+        # Two sequences, three seeds each; b's ATE is a's times the given ratios.
+        ratios = {"s1": [0.9, 1.1, 1.0], "s2": [0.8, 0.95, 1.05]}
+        per_run = []
+        for seq, rs in ratios.items():
+            for seed, r in enumerate(rs, start=1):
+                per_run.append({"sequence": seq, "variant": "a", "seed": seed, "ate": 0.1, "rc": 0})
+                per_run.append({"sequence": seq, "variant": "b", "seed": seed, "ate": 0.1 * r, "rc": 0})
+        text = bench.compare_table(bench.aggregate(per_run), "a", "b", per_run)
+        logs = [math.log(r) for rs in ratios.values() for r in rs]
+        mean = sum(logs) / 6
+        sd = math.sqrt(sum((x - mean) ** 2 for x in logs) / 5)
+        half = 2.571 * sd / math.sqrt(6)  # t, 5 degrees of freedom
+        self.assertIn(f"All 6 paired runs: ATE ratio b/a {math.exp(mean):.3f} (geometric mean; "
+                      f"95 % interval {math.exp(mean - half):.3f}–{math.exp(mean + half):.3f}); "
+                      "3 of 6 runs lower with b.", text)
+        # Identical runs: ratio 1 with no spread.
+        same = [r | {"ate": 0.1} for r in per_run]
+        self.assertIn("ATE ratio b/a 1.000 (geometric mean; 95 % interval 1.000–1.000); 0 of 6",
+                      bench.compare_table(bench.aggregate(same), "a", "b", same))
+        # One run per variant: nothing to pool.
+        self.assertNotIn("paired runs", bench.compare_table(bench.aggregate(per_run[:2]), "a", "b",
+                                                            per_run[:2]))
+
     def test_ablation_table_against_reference(self):
         def res(v, ate, opt, pts, lns):
             return {"sequence": "sim_MH_05", "variant": v, "ate": ate, "opt_total_median": opt,
