@@ -180,7 +180,12 @@ TEST(Config, PatchAnchorSettingsAreReadAndBadOnesAreRejected) {
   EXPECT_DOUBLE_EQ(c.points.anchors.min_zncc, 0.7);
   EXPECT_EQ(c.points.anchors.warp, "affine");
   EXPECT_TRUE(c.points.anchors.end_mismatched);
+  EXPECT_FALSE(c.points.anchors.skip_backward_when_aligned);
   const std::string dir = test::scratchDir();
+  const std::string skip = test::writeFile(
+      dir + "/skip.yaml",
+      eurocYamlReplacing("skip_backward_when_aligned: false", "skip_backward_when_aligned: true"));
+  EXPECT_TRUE(Config::load(skip).points.anchors.skip_backward_when_aligned);
   const std::string window =
       test::writeFile(dir + "/window.yaml", eurocYamlReplacing("    window: 21", "    window: 20"));
   expectErrorMentioning([&] { Config::load(window); }, {"points.anchors.window", "odd"});
