@@ -189,13 +189,7 @@ FeatureFrame PointTracker::track(const cv::Mat& gray, int64_t t_ns, FrameTiming*
       if (!aligned_first) {
         for (std::size_t i = 0; i < status.size(); ++i)
           status[i] = status[i] && camera_->inImage({next[i].x, next[i].y}, 1.0);
-        std::vector<cv::Point2f> prev = pts_;
-        keep(&prev, status);
-        keep(&next, status);
-        keep(&ids_, status);
-        keep(&track_counts_, status);
-        rejectWithFundamental(&prev, &next, &ids_, &track_counts_);
-        pts_ = next;
+        advance(std::move(next), status);
         if (options_.anchors.enabled) alignToAnchors(img);
       }
     } else {
@@ -306,13 +300,17 @@ void PointTracker::trackAlignedFirst(const std::vector<cv::Mat>& pyramid, const 
   }
   for (std::size_t i = 0; i < pts_.size(); ++i)
     if (aligned[i] && anchors_.dueForReanchor(ids_[i])) anchors_.anchor(ids_[i], img, next[i]);
+  advance(std::move(next), status);
+}
+
+void PointTracker::advance(std::vector<cv::Point2f> next, const std::vector<uchar>& status) {
   std::vector<cv::Point2f> prev = pts_;
   keep(&prev, status);
   keep(&next, status);
   keep(&ids_, status);
   keep(&track_counts_, status);
   rejectWithFundamental(&prev, &next, &ids_, &track_counts_);
-  pts_ = next;
+  pts_ = std::move(next);
 }
 
 void PointTracker::detectNew(const cv::Mat& img) {

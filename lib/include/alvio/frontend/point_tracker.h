@@ -63,6 +63,8 @@ class PointTracker {
   std::vector<cv::Point2f> rotated(const Eigen::Matrix3d& R,
                                    const std::vector<cv::Point2f>& px) const;
   void alignToAnchors(const cv::Mat& img);
+  /// The tracks `status` keeps move on to `next`, less those the fundamental matrix rejects.
+  void advance(std::vector<cv::Point2f> next, const std::vector<uchar>& status);
   /// KLT forward, each arrival aligned to its anchored patch, and only the arrivals no patch
   /// vouches for tracked back (anchors.skip_backward_when_aligned). Updates the tracks.
   void trackAlignedFirst(const std::vector<cv::Mat>& pyramid, const cv::Mat& img);
