@@ -219,8 +219,9 @@ class TablesTest(unittest.TestCase):
         per_run = []
         for seq, rs in ratios.items():
             for seed, r in enumerate(rs, start=1):
-                per_run.append({"sequence": seq, "variant": "a", "seed": seed, "ate": 0.1, "rc": 0})
-                per_run.append({"sequence": seq, "variant": "b", "seed": seed, "ate": 0.1 * r, "rc": 0})
+                run = {"sequence": seq, "seed": seed, "rc": 0}
+                per_run.append(run | {"variant": "a", "ate": 0.1})
+                per_run.append(run | {"variant": "b", "ate": 0.1 * r})
         text = bench.compare_table(bench.aggregate(per_run), "a", "b", per_run)
         logs = [math.log(r) for rs in ratios.values() for r in rs]
         mean = sum(logs) / 6
