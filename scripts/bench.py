@@ -358,7 +358,8 @@ T95 = [12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262, 2.228, 2.
 def pooled_ratio(ratios):
     """Geometric mean of B/A ratios with its 95 % interval (t on the log ratios), or None for
     fewer than two. A change whose interval holds 1 is not told apart from the runs' noise:
-    one seed's trajectory can move by 20 % from any small change (docs/benchmarks.md)."""
+    one seed's trajectory can move by 20 % from any small change to the tracking
+    (docs/benchmarks.md)."""
     logs = [math.log(r) for r in ratios if r is not None and r > 0]
     n = len(logs)
     if n < 2:
