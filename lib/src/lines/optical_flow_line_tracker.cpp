@@ -145,78 +145,95 @@ void OpticalFlowLineTracker::predict(const std::vector<cv::Mat>& pyramid, cv::Si
       samples.emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()));
     }
   }
-  std::vector<cv::Point2f> moved;
-  std::vector<uchar> status;
-  const auto& f = options_.flow;
-  const cv::Size win(f.klt_window_px, f.klt_window_px);
-  const cv::TermCriteria stop(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, f.klt_max_iterations,
-                              f.klt_epsilon);
-  // OpenCV fails a point whose window ended up wholly outside the image only while computing
-  // its error; fail it here instead (the same tracks as with the error).
-  const float half = (f.klt_window_px - 1) * 0.5f;
-  auto outside = [&](const cv::Point2f& p) {
-    auto off = [&](float x, int size) {
-      const int corner = cvFloor(x - half);
-      return corner < -f.klt_window_px || corner >= size;
-    };
-    return off(p.x, image_size.width) || off(p.y, image_size.height);
-  };
-  if (!usesRotation()) {
-    // Without KLT's error output, which nothing reads: about a tenth of the KLT time.
-    cv::calcOpticalFlowPyrLK(prev_pyramid_, pyramid, samples, moved, status, cv::noArray(), win,
-                             f.klt_pyramid_levels, stop);
-    for (std::size_t i = 0; i < moved.size(); ++i) status[i] = status[i] && !outside(moved[i]);
-  } else {
-    // Started where the gyroscope's rotation puts them (in the pinhole image the homography
-    // K R K^-1), samples need fewer levels; those that fail there try again on all levels.
-    const Eigen::Matrix3d& R = *rotationSincePrevious();
-    std::vector<cv::Point2f> predicted(samples.size());
-    for (std::size_t i = 0; i < samples.size(); ++i) {
-      const Eigen::Vector3d r =
-          R * undistorter().pixelToNormalised({samples[i].x, samples[i].y}).homogeneous();
-      predicted[i] = samples[i];  // turned behind the camera: KLT loses it either way
-      if (r.z() <= 0) continue;
-      const Eigen::Vector2d px = undistorter().normalisedToPixel(r.hnormalized());
-      predicted[i] = cv::Point2f(static_cast<float>(px.x()), static_cast<float>(px.y()));
-    }
-    moved = predicted;
-    cv::calcOpticalFlowPyrLK(prev_pyramid_, pyramid, samples, moved, status, cv::noArray(), win,
-                             f.gyro_klt_levels, stop, cv::OPTFLOW_USE_INITIAL_FLOW);
-    for (std::size_t i = 0; i < moved.size(); ++i) status[i] = status[i] && !outside(moved[i]);
-    // A line the few levels lost, or lost a sample of, tries again on all levels.
-    std::vector<std::size_t> again_lines;
-    for (std::size_t t = 0; t < tracks_.size(); ++t) {
-      predictions_[t].valid =
-          predictOne(tracks_[t], moved, status, t * n, image_size, &predictions_[t]);
-      const bool all_samples = std::all_of(status.begin() + t * n, status.begin() + (t + 1) * n,
-                                           [](uchar ok) { return ok != 0; });
-      if (!predictions_[t].valid || !all_samples) again_lines.push_back(t);
-    }
-    if (again_lines.empty() || f.gyro_klt_levels >= f.klt_pyramid_levels) return;
-    std::vector<cv::Point2f> from, to;
-    for (std::size_t t : again_lines)
-      for (int k = 0; k < n; ++k) {
-        from.push_back(samples[t * n + k]);
-        to.push_back(predicted[t * n + k]);
-      }
-    std::vector<uchar> again;
-    cv::calcOpticalFlowPyrLK(prev_pyramid_, pyramid, from, to, again, cv::noArray(), win,
-                             f.klt_pyramid_levels, stop, cv::OPTFLOW_USE_INITIAL_FLOW);
-    for (std::size_t j = 0; j < again_lines.size(); ++j) {
-      const std::size_t t = again_lines[j];
-      for (int k = 0; k < n; ++k) {
-        moved[t * n + k] = to[j * n + k];
-        status[t * n + k] = again[j * n + k] && !outside(to[j * n + k]);
-      }
-      predictions_[t] = Prediction();
-      predictions_[t].valid =
-          predictOne(tracks_[t], moved, status, t * n, image_size, &predictions_[t]);
-    }
+  if (usesRotation()) {
+    predictFromRotation(pyramid, image_size, samples);
     return;
   }
+  std::vector<cv::Point2f> moved;
+  std::vector<uchar> status;
+  // Without KLT's error output, which nothing reads: about a tenth of the KLT time.
+  cv::calcOpticalFlowPyrLK(prev_pyramid_, pyramid, samples, moved, status, cv::noArray(),
+                           kltWindow(), options_.flow.klt_pyramid_levels, kltStop());
+  for (std::size_t i = 0; i < moved.size(); ++i)
+    status[i] = status[i] && !windowOutside(moved[i], image_size);
   for (std::size_t i = 0; i < tracks_.size(); ++i)
     predictions_[i].valid =
         predictOne(tracks_[i], moved, status, i * n, image_size, &predictions_[i]);
+}
+
+void OpticalFlowLineTracker::predictFromRotation(const std::vector<cv::Mat>& pyramid,
+                                                 cv::Size image_size,
+                                                 const std::vector<cv::Point2f>& samples) {
+  const auto& f = options_.flow;
+  const std::size_t n = static_cast<std::size_t>(f.samples_per_line);
+  // Started where the gyroscope's rotation puts them (in the pinhole image the homography
+  // K R K^-1), samples need fewer levels; those that fail there try again on all levels.
+  const Eigen::Matrix3d& R = *rotationSincePrevious();
+  std::vector<cv::Point2f> predicted(samples.size());
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    const Eigen::Vector3d r =
+        R * undistorter().pixelToNormalised({samples[i].x, samples[i].y}).homogeneous();
+    predicted[i] = samples[i];  // turned behind the camera: KLT loses it either way
+    if (r.z() <= 0) continue;
+    const Eigen::Vector2d px = undistorter().normalisedToPixel(r.hnormalized());
+    predicted[i] = cv::Point2f(static_cast<float>(px.x()), static_cast<float>(px.y()));
+  }
+  std::vector<cv::Point2f> moved = predicted;
+  std::vector<uchar> status;
+  cv::calcOpticalFlowPyrLK(prev_pyramid_, pyramid, samples, moved, status, cv::noArray(),
+                           kltWindow(), f.gyro_klt_levels, kltStop(), cv::OPTFLOW_USE_INITIAL_FLOW);
+  for (std::size_t i = 0; i < moved.size(); ++i)
+    status[i] = status[i] && !windowOutside(moved[i], image_size);
+  // A line the few levels lost, or lost a sample of, tries again on all levels.
+  std::vector<std::size_t> again_lines;
+  for (std::size_t t = 0; t < tracks_.size(); ++t) {
+    predictions_[t].valid =
+        predictOne(tracks_[t], moved, status, t * n, image_size, &predictions_[t]);
+    const bool all_samples = std::all_of(status.begin() + t * n, status.begin() + (t + 1) * n,
+                                         [](uchar ok) { return ok != 0; });
+    if (!predictions_[t].valid || !all_samples) again_lines.push_back(t);
+  }
+  if (again_lines.empty() || f.gyro_klt_levels >= f.klt_pyramid_levels) return;
+  std::vector<cv::Point2f> from, to;
+  for (std::size_t t : again_lines)
+    for (std::size_t k = 0; k < n; ++k) {
+      from.push_back(samples[t * n + k]);
+      to.push_back(predicted[t * n + k]);
+    }
+  std::vector<uchar> again;
+  cv::calcOpticalFlowPyrLK(prev_pyramid_, pyramid, from, to, again, cv::noArray(), kltWindow(),
+                           f.klt_pyramid_levels, kltStop(), cv::OPTFLOW_USE_INITIAL_FLOW);
+  for (std::size_t j = 0; j < again_lines.size(); ++j) {
+    const std::size_t t = again_lines[j];
+    for (std::size_t k = 0; k < n; ++k) {
+      moved[t * n + k] = to[j * n + k];
+      status[t * n + k] = again[j * n + k] && !windowOutside(to[j * n + k], image_size);
+    }
+    predictions_[t] = Prediction();
+    predictions_[t].valid =
+        predictOne(tracks_[t], moved, status, t * n, image_size, &predictions_[t]);
+  }
+}
+
+cv::Size OpticalFlowLineTracker::kltWindow() const {
+  return cv::Size(options_.flow.klt_window_px, options_.flow.klt_window_px);
+}
+
+cv::TermCriteria OpticalFlowLineTracker::kltStop() const {
+  return cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS,
+                          options_.flow.klt_max_iterations, options_.flow.klt_epsilon);
+}
+
+bool OpticalFlowLineTracker::windowOutside(const cv::Point2f& p, cv::Size image_size) const {
+  // OpenCV fails a point whose window ended up wholly outside the image only while computing
+  // its error; fail it here instead (the same tracks as with the error).
+  const int side = options_.flow.klt_window_px;
+  const float half = (side - 1) * 0.5f;
+  auto off = [&](float x, int size) {
+    const int corner = cvFloor(x - half);
+    return corner < -side || corner >= size;
+  };
+  return off(p.x, image_size.width) || off(p.y, image_size.height);
 }
 
 bool OpticalFlowLineTracker::detectsThisFrame() {

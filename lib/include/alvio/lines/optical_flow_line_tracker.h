@@ -53,6 +53,14 @@ class OpticalFlowLineTracker final : public LineTracker {
     int count;
   };
   void predict(const std::vector<cv::Mat>& pyramid, cv::Size image_size);
+  /// predict() when the flow starts from the gyroscope's rotation: few levels first, then all
+  /// levels for the lines that lost a sample or their prediction there.
+  void predictFromRotation(const std::vector<cv::Mat>& pyramid, cv::Size image_size,
+                           const std::vector<cv::Point2f>& samples);
+  cv::Size kltWindow() const;
+  cv::TermCriteria kltStop() const;
+  /// Whether a KLT window centred on `p` lies wholly outside the image.
+  bool windowOutside(const cv::Point2f& p, cv::Size image_size) const;
   /// Whether this frame's flow starts from the gyroscope's rotation.
   bool usesRotation() const { return options_.flow.gyro_flow && rotationSincePrevious(); }
   /// Steps 2 and 3: this frame's lines from the predictions and the detections.
