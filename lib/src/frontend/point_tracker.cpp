@@ -239,20 +239,27 @@ void PointTracker::alignToAnchors(const cv::Mat& img) {
   std::vector<uchar> keep_track(pts_.size(), 1);
   for (std::size_t i = 0; i < pts_.size(); ++i) {
     const Alignment a = anchors_.refine(ids_[i], img, &pts_[i]);
-    if (a == Alignment::kOutside) continue;  // KLT's position; the patch may fit again later
-    if (a == Alignment::kMismatch && options_.anchors.end_mismatched) {
+    if (endsTrack(a)) {
       keep_track[i] = 0;
       continue;
     }
-    // A patch that no longer aligns (the view changed too much), that never did (too little
-    // texture to anchor: the track goes on KLT alone), or that has served long enough, is
-    // taken again where the track is now.
-    if (a != Alignment::kAligned || anchors_.dueForReanchor(ids_[i]))
-      anchors_.anchor(ids_[i], img, pts_[i]);
+    retakePatch(ids_[i], img, pts_[i], a);
   }
   keep(&pts_, keep_track);
   keep(&ids_, keep_track);
   keep(&track_counts_, keep_track);
+}
+
+bool PointTracker::endsTrack(Alignment a) const {
+  return a == Alignment::kMismatch && options_.anchors.end_mismatched;
+}
+
+void PointTracker::retakePatch(int id, const cv::Mat& img, const cv::Point2f& p, Alignment a) {
+  if (a == Alignment::kOutside) return;  // KLT's position; the patch may fit again later
+  // A patch that no longer aligns (the view changed too much), that never did (too little
+  // texture to anchor: the track goes on KLT alone), or that has served long enough, is
+  // taken again where the track is now.
+  if (a != Alignment::kAligned || anchors_.dueForReanchor(id)) anchors_.anchor(id, img, p);
 }
 
 void PointTracker::trackAlignedFirst(const std::vector<cv::Mat>& pyramid, const cv::Mat& img) {
@@ -260,9 +267,8 @@ void PointTracker::trackAlignedFirst(const std::vector<cv::Mat>& pyramid, const 
   std::vector<uchar> status;
   flow(prev_pyramid_, pyramid, pts_, &next, &status, options_.klt_levels);
   anchors_.tick();
-  std::vector<uchar> aligned(pts_.size(), 0);
+  std::vector<Alignment> alignment(pts_.size(), Alignment::kOutside);
   std::vector<std::size_t> unchecked;
-  std::vector<Alignment> outcome;  // of each unchecked corner's alignment
   std::vector<cv::Point2f> arrivals, origins;
   for (std::size_t i = 0; i < pts_.size(); ++i) {
     if (!status[i] || !camera_->inImage({next[i].x, next[i].y}, 1.0)) {
@@ -270,36 +276,25 @@ void PointTracker::trackAlignedFirst(const std::vector<cv::Mat>& pyramid, const 
       continue;
     }
     const cv::Point2f arrival = next[i];
-    const Alignment a = anchors_.refine(ids_[i], img, &next[i]);
-    if (a == Alignment::kAligned) {
-      aligned[i] = 1;
-      continue;
-    }
-    if (a == Alignment::kMismatch && options_.anchors.end_mismatched) {
+    alignment[i] = anchors_.refine(ids_[i], img, &next[i]);
+    if (alignment[i] == Alignment::kAligned) continue;
+    if (endsTrack(alignment[i])) {
       status[i] = 0;
       continue;
     }
     unchecked.push_back(i);
-    outcome.push_back(a);
     arrivals.push_back(arrival);
     origins.push_back(pts_[i]);
   }
   if (!unchecked.empty()) {
     const std::vector<uchar> back =
         returns(prev_pyramid_, pyramid, arrivals, origins, origins, options_.klt_levels);
-    for (std::size_t k = 0; k < unchecked.size(); ++k) {
-      const std::size_t i = unchecked[k];
-      if (!back[k]) {
-        status[i] = 0;
-        continue;
-      }
-      // As alignToAnchors: a patch that did not align is taken again where KLT is; one
-      // reaching out of the image keeps waiting.
-      if (outcome[k] != Alignment::kOutside) anchors_.anchor(ids_[i], img, next[i]);
-    }
+    for (std::size_t k = 0; k < unchecked.size(); ++k)
+      if (!back[k]) status[unchecked[k]] = 0;
   }
+  // The surviving tracks' patches, as in alignToAnchors.
   for (std::size_t i = 0; i < pts_.size(); ++i)
-    if (aligned[i] && anchors_.dueForReanchor(ids_[i])) anchors_.anchor(ids_[i], img, next[i]);
+    if (status[i]) retakePatch(ids_[i], img, next[i], alignment[i]);
   advance(std::move(next), status);
 }
 

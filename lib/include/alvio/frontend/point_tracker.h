@@ -63,6 +63,11 @@ class PointTracker {
   std::vector<cv::Point2f> rotated(const Eigen::Matrix3d& R,
                                    const std::vector<cv::Point2f>& px) const;
   void alignToAnchors(const cv::Mat& img);
+  /// Whether an alignment ends its track: a confirmed patch that stopped fitting, when
+  /// anchors.end_mismatched.
+  bool endsTrack(Alignment a) const;
+  /// Takes track `id`'s patch again at `p` when its alignment `a` calls for it.
+  void retakePatch(int id, const cv::Mat& img, const cv::Point2f& p, Alignment a);
   /// The tracks `status` keeps move on to `next`, less those the fundamental matrix rejects.
   void advance(std::vector<cv::Point2f> next, const std::vector<uchar>& status);
   /// KLT forward, each arrival aligned to its anchored patch, and only the arrivals no patch
