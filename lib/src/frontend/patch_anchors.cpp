@@ -109,6 +109,9 @@ bool PatchAnchors::anchor(int id, const cv::Mat& image, const cv::Point2f& p) {
       block[1] = patch.values[k];
       for (int i = 0; i < k_params_; ++i) block[2 + i] = patch.sd[i][k];
     }
+    // The warps read only the packed blocks: not two copies of the same template.
+    patch.values = {};
+    patch.sd = {};
   }
   patches_[id] = std::move(patch);
   return true;

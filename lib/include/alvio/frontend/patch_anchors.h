@@ -73,10 +73,11 @@ class PatchAnchors {
 
  private:
   struct Patch {
-    std::vector<float> values;  ///< zero-mean template, window x window, row-major
+    /// Zero-mean template, window x window, row-major (kept for the shift alone).
+    std::vector<float> values;
     /// Steepest-descent images: the template's gradient times the warp's Jacobian, for the
     /// x- and y-shift, then the linear part's parameters (similarity: scale, rotation;
-    /// affine: its four entries) about the patch centre.
+    /// affine: its four entries) about the patch centre (kept for the shift alone).
     std::array<std::vector<float>, 6> sd;
     /// For the warps: per pixel 8 floats {1, value, sd[0..5]} (unused ones 0), so that one
     /// pass multiplies a warped sample into all its sums at once, each sum still added up in
