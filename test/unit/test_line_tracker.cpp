@@ -9,6 +9,7 @@
 #include <iostream>
 #include <map>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <set>
 
 #include "alvio/camera/camera_model.h"
@@ -16,6 +17,7 @@
 #include "alvio/config/config.h"
 #include "alvio/config/yaml_reader.h"
 #include "alvio/lines/descriptor_line_tracker.h"
+#include "alvio/lines/image_undistorter.h"
 #include "alvio/lines/line_detector.h"
 #include "alvio/lines/linear_time_lsd.h"
 #include "alvio/lines/optical_flow_line_tracker.h"
@@ -590,6 +592,58 @@ TEST(LineTracker, DistortedStraightEdgeComesOutStraightInNormalisedCoordinates) 
                 (obs.start_px.x() - camera.intrinsics[2]) / camera.intrinsics[0], 1e-12);
   }
   EXPECT_EQ(found, 2);
+}
+
+TEST(ImageUndistorter, GivesCvRemapsImageBitForBitBorderIncluded) {
+  // The reference: cv::remap with tables made from the camera model as the constructor makes
+  // them. Three cameras: EuRoC's (every pinhole pixel has its four sources in the image), a
+  // fisheye and a pincushion, whose pinhole corners map outside the raw image.
+  CameraOptions euroc = Config::load(test::sourcePath("config/euroc.yaml")).camera;
+  CameraOptions pincushion = euroc;
+  pincushion.distortion_coefficients = {0.25, 0.05, 0.001, -0.002};
+  CameraOptions fisheye = euroc;
+  fisheye.distortion_model = "equidistant";
+  fisheye.distortion_coefficients = {0.3, 0.1, -0.05, 0.01};
+  cv::RNG rng(7);
+  std::vector<int> outside_sources;
+  for (const CameraOptions& camera : {euroc, fisheye, pincushion}) {
+    const auto model = CameraModel::create(camera);
+    const cv::Size size(camera.width, camera.height);
+    cv::Mat map_x(size, CV_32FC1), map_y(size, CV_32FC1);
+    for (int v = 0; v < size.height; ++v) {
+      for (int u = 0; u < size.width; ++u) {
+        const Eigen::Vector2d xy((u - camera.intrinsics[2]) / camera.intrinsics[0],
+                                 (v - camera.intrinsics[3]) / camera.intrinsics[1]);
+        const Eigen::Vector2d raw = model->distort(xy);
+        map_x.at<float>(v, u) = static_cast<float>(raw.x());
+        map_y.at<float>(v, u) = static_cast<float>(raw.y());
+      }
+    }
+    cv::Mat map_xy, map_frac;
+    cv::convertMaps(map_x, map_y, map_xy, map_frac, CV_16SC2);
+    int outside = 0;
+    for (int v = 0; v < size.height; ++v)
+      for (int u = 0; u < size.width; ++u) {
+        const cv::Vec2s s = map_xy.at<cv::Vec2s>(v, u);
+        outside += s[0] < 0 || s[1] < 0 || s[0] >= size.width - 1 || s[1] >= size.height - 1;
+      }
+    outside_sources.push_back(outside);
+
+    const ImageUndistorter undistorter(camera);
+    cv::Mat noise(size, CV_8UC1), white(size, CV_8UC1, cv::Scalar(255));
+    rng.fill(noise, cv::RNG::UNIFORM, 0, 256);
+    for (const cv::Mat& raw : {noise, white}) {
+      cv::Mat expected;
+      cv::remap(raw, expected, map_xy, map_frac, cv::INTER_LINEAR, cv::BORDER_CONSTANT,
+                cv::Scalar(0));
+      const cv::Mat got = undistorter.undistort(raw);
+      ASSERT_EQ(got.size(), expected.size());
+      EXPECT_EQ(cv::countNonZero(got != expected), 0)
+          << camera.distortion_model << " " << camera.distortion_coefficients[0];
+    }
+  }
+  EXPECT_EQ(outside_sources[0], 0);
+  EXPECT_GT(outside_sources[2], 1000) << "the border path must be exercised";
 }
 
 TEST(LineTrackerOptions, LoadFromYamlAndNameBadKeys) {

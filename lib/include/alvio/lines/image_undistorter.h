@@ -7,7 +7,9 @@
 // own CameraModel, so every distortion model it supports is handled the same way.
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <opencv2/core.hpp>
+#include <vector>
 
 #include "alvio/config/sensor_options.h"
 
@@ -17,7 +19,9 @@ class ImageUndistorter {
  public:
   explicit ImageUndistorter(const CameraOptions& camera);
 
-  /// The pinhole image (bilinear). Without distortion the input is returned as is (no copy).
+  /// The pinhole image (bilinear), bit for bit what cv::remap gives with the fixed-point
+  /// tables of cv::convertMaps and a black border. Without distortion the input is returned as
+  /// is (no copy).
   cv::Mat undistort(const cv::Mat& raw) const;
   /// 255 where the pinhole pixel has a source pixel in the raw image, 0 elsewhere (CV_8U).
   const cv::Mat& validMask() const { return valid_mask_; }
@@ -41,7 +45,18 @@ class ImageUndistorter {
   cv::Size size_;
   double fx_, fy_, cx_, cy_;
   bool has_distortion_;
+  // A pinhole pixel whose 2x2 source neighbourhood is not wholly inside the raw image.
+  struct BorderPixel {
+    int index, source_x, source_y, fraction;
+  };
+  cv::Mat remapBilinear(const cv::Mat& raw) const;
+
   cv::Mat map_xy_, map_frac_;  // fixed-point remap tables (cv::convertMaps)
+  // The same tables per pinhole pixel, row-major: the raw image offset of the top-left source
+  // pixel (sy * width + sx; 0 for a border pixel) and the 5+5-bit sub-pixel fraction (y, x).
+  std::vector<std::int32_t> source_offset_;
+  std::vector<std::uint16_t> source_fraction_;
+  std::vector<BorderPixel> border_pixels_;
   cv::Mat valid_mask_;
 };
 
