@@ -27,7 +27,6 @@ inline std::uint8_t blend(int top_left, int top_right, int bottom_left, int bott
 }
 }  // namespace
 
-
 ImageUndistorter::ImageUndistorter(const CameraOptions& camera)
     : size_(camera.width, camera.height),
       fx_(camera.intrinsics[0]),
@@ -75,8 +74,7 @@ ImageUndistorter::ImageUndistorter(const CameraOptions& camera)
 
 cv::Mat ImageUndistorter::undistort(const cv::Mat& raw) const {
   if (!has_distortion_) return raw;
-  if (raw.type() == CV_8UC1 && raw.size() == size_ && raw.isContinuous())
-    return remapBilinear(raw);
+  if (raw.type() == CV_8UC1 && raw.size() == size_ && raw.isContinuous()) return remapBilinear(raw);
   cv::Mat out;
   cv::remap(raw, out, map_xy_, map_frac_, cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar(0));
   return out;
