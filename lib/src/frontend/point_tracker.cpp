@@ -14,8 +14,7 @@ PointTracker::PointTracker(const PointTrackerOptions& options,
                            std::shared_ptr<const CameraModel> camera)
     : options_(options),
       camera_(std::move(camera)),
-      clahe_(cv::createCLAHE(options.clahe_clip_limit,
-                             cv::Size(options.clahe_tiles, options.clahe_tiles))),
+      clahe_(options.clahe_clip_limit, options.clahe_tiles),
       anchors_(options.anchors) {}
 
 void PointTracker::reset() {
@@ -135,7 +134,7 @@ FeatureFrame PointTracker::track(const cv::Mat& gray, int64_t t_ns, FrameTiming*
   {
     ScopedStage stage(timing, "preprocess");
     if (options_.equalize)
-      clahe_->apply(gray, img);
+      clahe_.apply(gray, img);
     else
       img = gray;
   }

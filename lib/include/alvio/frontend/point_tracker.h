@@ -12,6 +12,7 @@
 
 #include "alvio/camera/camera_model.h"
 #include "alvio/common/timing.h"
+#include "alvio/frontend/clahe.h"
 #include "alvio/frontend/corner_detector.h"
 #include "alvio/frontend/feature_frame.h"
 #include "alvio/frontend/patch_anchors.h"
@@ -76,7 +77,7 @@ class PointTracker {
 
   PointTrackerOptions options_;
   std::shared_ptr<const CameraModel> camera_;
-  cv::Ptr<cv::CLAHE> clahe_;
+  Clahe clahe_;
   CornerDetector corners_;
   PatchAnchors anchors_;
   std::vector<cv::Mat> prev_pyramid_;  // with gradients, for KLT
