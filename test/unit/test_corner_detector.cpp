@@ -113,3 +113,18 @@ TEST(CornerDetector, EmptyWhenTheMaskCoversEverything) {
   const cv::Mat img = texture({200, 100}, 7);
   EXPECT_TRUE(detector.detect(img, 50, 0.01, 10, cv::Mat::zeros(img.size(), CV_8UC1)).empty());
 }
+
+TEST(CornerDetector, ThresholdComesFromTheStrongestCornerInsideTheMask) {
+  // A faint texture and one high-contrast square: with quality 0.2, the square's corners set a
+  // threshold no texture corner reaches. Masked, the texture's own strongest sets it.
+  cv::Mat img = texture({752, 480}, 5);
+  img = img / 3 + 60;
+  cv::rectangle(img, cv::Rect(300, 200, 60, 60), cv::Scalar(255), cv::FILLED);
+  cv::Mat mask(img.size(), CV_8UC1, cv::Scalar(255));
+  cv::rectangle(mask, cv::Rect(280, 180, 100, 100), cv::Scalar(0), cv::FILLED);
+  CornerDetector detector;
+  expectSameAsOpenCv(&detector, img, 150, 0.2, 10, cv::Mat());
+  expectSameAsOpenCv(&detector, img, 150, 0.2, 10, mask);
+  EXPECT_LE(detector.detect(img, 150, 0.2, 10, cv::Mat()).size(), 4u);
+  EXPECT_GT(detector.detect(img, 150, 0.2, 10, mask).size(), 20u);
+}
