@@ -145,10 +145,8 @@ FeatureFrame PointTracker::track(const cv::Mat& gray, int64_t t_ns, FrameTiming*
     // The image's pyramid and gradients, built once: the forward pass needs the previous
     // frame's, the backward pass this frame's, and this frame's serve the next frame again
     // (calcOpticalFlowPyrLK on plain images would build them four times a frame). Never
-    // reuse the caller's buffer (tryReuseInputImage = false). The pyramid of two frames ago
-    // is built over, so its buffers are not allocated and faulted in again.
-    std::vector<cv::Mat> pyramid = std::move(spare_pyramid_);
-    spare_pyramid_.clear();
+    // reuse the caller's buffer (tryReuseInputImage = false).
+    std::vector<cv::Mat> pyramid;
     cv::buildOpticalFlowPyramid(img, pyramid, win, options_.klt_levels, true,
                                 cv::BORDER_REFLECT_101, cv::BORDER_CONSTANT, false);
     if (!prev_pyramid_.empty() && !pts_.empty()) {
@@ -198,7 +196,6 @@ FeatureFrame PointTracker::track(const cv::Mat& gray, int64_t t_ns, FrameTiming*
       ids_.clear();
       track_counts_.clear();
     }
-    spare_pyramid_ = std::move(prev_pyramid_);
     prev_pyramid_ = std::move(pyramid);
     for (int& c : track_counts_) ++c;
   }

@@ -258,11 +258,9 @@ void OpticalFlowLineTracker::associate(const cv::Mat& undistorted,
                                        const std::vector<LineSegment>& detections, bool detected,
                                        LineFrame* frame) {
   const auto& f = options_.flow;
+  std::vector<cv::Mat> pyramid;
   // Built once per frame and kept as the next frame's previous pyramid. Never share the
-  // caller's buffer (tryReuseInputImage = false): it may be overwritten after we return. The
-  // pyramid of two frames ago is built over, so its buffers are not allocated again.
-  std::vector<cv::Mat> pyramid = std::move(spare_pyramid_);
-  spare_pyramid_.clear();
+  // caller's buffer (tryReuseInputImage = false): it may be overwritten after we return.
   cv::buildOpticalFlowPyramid(undistorted, pyramid, cv::Size(f.klt_window_px, f.klt_window_px),
                               f.klt_pyramid_levels, true, cv::BORDER_REFLECT_101,
                               cv::BORDER_CONSTANT, false);
@@ -279,7 +277,6 @@ void OpticalFlowLineTracker::associate(const cv::Mat& undistorted,
     frame->lines.push_back(obs);
   }
   tracks_ = std::move(next);
-  spare_pyramid_ = std::move(prev_pyramid_);
   prev_pyramid_ = std::move(pyramid);
 }
 

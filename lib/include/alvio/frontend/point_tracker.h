@@ -80,8 +80,7 @@ class PointTracker {
   Clahe clahe_;
   CornerDetector corners_;
   PatchAnchors anchors_;
-  std::vector<cv::Mat> prev_pyramid_;   // with gradients, for KLT
-  std::vector<cv::Mat> spare_pyramid_;  // two frames old, built over (no one else holds it)
+  std::vector<cv::Mat> prev_pyramid_;  // with gradients, for KLT
   int64_t prev_t_ns_ = 0;
   std::vector<cv::Point2f> pts_;
   std::vector<int> ids_, track_counts_;

@@ -73,7 +73,6 @@ class OpticalFlowLineTracker final : public LineTracker {
 
   std::vector<Track> tracks_;
   std::vector<cv::Mat> prev_pyramid_;
-  std::vector<cv::Mat> spare_pyramid_;  // two frames old, built over (no one else holds it)
   std::vector<Prediction> predictions_;
   int frames_since_detection_ = 0;
 };
