@@ -1,6 +1,8 @@
 // alvio_line_bench: lines per frame, track lengths and time per frame of the line front end
 // (optical-flow tracker and descriptor baseline) on image folders, beside a KLT point front end
-// (goodFeaturesToTrack + calcOpticalFlowPyrLK) on the same frames as the speed reference.
+// (goodFeaturesToTrack + calcOpticalFlowPyrLK) on the same frames as the speed reference. On
+// an EuRoC mav0/cam0/data folder the line flow starts from the gyroscope's rotation (imu0), as
+// in the pipeline; other folders run without it.
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
@@ -11,12 +13,15 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
+#include <optional>
 #include <set>
 #include <sstream>
 
 #include "alvio/common/arg_parser.h"
 #include "alvio/common/error.h"
 #include "alvio/config/config.h"
+#include "alvio/frontend/gyro_rotation.h"
+#include "alvio/io/euroc_dataset.h"
 #include "alvio/io/trajectory_io.h"
 #include "alvio/lines/line_tracker.h"
 
@@ -48,21 +53,55 @@ nlohmann::json toJson(const Summary& s) {
   return {{"median", s.median}, {"p95", s.p95}, {"mean", s.mean}};
 }
 
-std::vector<cv::Mat> loadImages(const std::string& dir) {
-  std::vector<std::string> files;
+struct ImageFolder {
+  std::vector<cv::Mat> images;
+  std::vector<int64_t> stamps_ns;  // from EuRoC's file names (nanoseconds); empty otherwise
+};
+
+ImageFolder loadImages(const std::string& dir) {
+  std::vector<fs::path> files;
   for (const auto& e : fs::directory_iterator(dir)) {
     const std::string ext = e.path().extension().string();
-    if (ext == ".png" || ext == ".jpg" || ext == ".jpeg") files.push_back(e.path().string());
+    if (ext == ".png" || ext == ".jpg" || ext == ".jpeg") files.push_back(e.path());
   }
   std::sort(files.begin(), files.end());  // EuRoC names are timestamps of equal length
-  std::vector<cv::Mat> images;
+  ImageFolder folder;
+  bool stamped = true;
   for (const auto& f : files) {
-    cv::Mat g = cv::imread(f, cv::IMREAD_GRAYSCALE);
-    if (g.empty()) throw Error("cannot read image " + f);
-    images.push_back(g);
+    cv::Mat g = cv::imread(f.string(), cv::IMREAD_GRAYSCALE);
+    if (g.empty()) throw Error("cannot read image " + f.string());
+    folder.images.push_back(g);
+    const std::string stem = f.stem().string();
+    stamped = stamped && !stem.empty() && stem.size() <= 19 &&
+              std::all_of(stem.begin(), stem.end(), [](char c) { return c >= '0' && c <= '9'; });
+    if (stamped) folder.stamps_ns.push_back(std::stoll(stem));
   }
-  if (images.size() < 2) throw Error(dir + ": need at least two images");
-  return images;
+  if (!stamped) folder.stamps_ns.clear();
+  if (folder.images.size() < 2) throw Error(dir + ": need at least two images");
+  return folder;
+}
+
+// The camera's rotation since the previous frame for every frame of an EuRoC cam0/data folder,
+// from the gyroscope in the sibling imu0/data.csv, as the pipeline gives it to the line
+// tracker. Empty when the folder is not one, so that the trackers run without it.
+std::vector<std::optional<Eigen::Matrix3d>> gyroRotations(const std::string& dir,
+                                                          const std::vector<int64_t>& stamps_ns,
+                                                          const Config& config,
+                                                          std::string* source) {
+  const fs::path imu_csv =
+      fs::path(dir).lexically_normal().parent_path().parent_path() / "imu0" / "data.csv";
+  if (stamps_ns.empty() || !fs::exists(imu_csv)) {
+    *source = "none (not an EuRoC mav0/cam0/data folder with imu0/data.csv beside it)";
+    return {};
+  }
+  GyroRotation gyro(config.camera.T_b_c.linear());
+  for (const ImuSample& s : readEurocImuCsv(imu_csv.string(), TimeOrderPolicy::kSortAndDedup))
+    gyro.add(s);
+  std::vector<std::optional<Eigen::Matrix3d>> rotations(stamps_ns.size());
+  for (std::size_t k = 1; k < stamps_ns.size(); ++k)
+    rotations[k] = gyro.cameraRotation(stamps_ns[k - 1], stamps_ns[k]);
+  *source = imu_csv.string();
+  return rotations;
 }
 
 // The reference point front end, VINS-Mono style without the RANSAC: track the previous
@@ -192,7 +231,7 @@ nlohmann::json lineReport(const LineRun& first) {
 
 void printSequence(const std::string& name, const nlohmann::json& j) {
   std::cout << "\n== " << name << " (" << j["frames"] << " frames, " << j["repeats"]
-            << " timing repeats)\n";
+            << " timing repeats; gyroscope: " << j["gyroscope"].get<std::string>() << ")\n";
   std::cout << std::fixed << std::setprecision(2);
   for (const char* tracker : {"flow", "descriptor"}) {
     const auto& t = j[tracker];
@@ -246,8 +285,14 @@ int main(int argc, char** argv) {
 
     nlohmann::json report = nlohmann::json::object();
     for (const std::string& dir : args.positional()) {
-      const std::vector<cv::Mat> images = loadImages(dir);
-      nlohmann::json seq = {{"folder", dir}, {"frames", images.size()}, {"repeats", repeats}};
+      const ImageFolder folder = loadImages(dir);
+      const std::vector<cv::Mat>& images = folder.images;
+      std::string gyro_source;
+      const auto rotations = gyroRotations(dir, folder.stamps_ns, config, &gyro_source);
+      nlohmann::json seq = {{"folder", dir},
+                            {"frames", images.size()},
+                            {"repeats", repeats},
+                            {"gyroscope", gyro_source}};
       // The front ends take turns on every frame, so that the load of the machine (shared
       // cores) weighs on all of them alike.
       const std::vector<std::string> types = {"flow", "descriptor"};
@@ -272,7 +317,9 @@ int main(int argc, char** argv) {
               if (k > 0) (always ? point_always_ms : point_ms).push_back(ms);
               continue;
             }
-            const LineFrame f = trackers[i]->track(images[k], 0.05 * k);
+            const double t = folder.stamps_ns.empty() ? 0.05 * k : folder.stamps_ns[k] * 1e-9;
+            const LineFrame f = rotations.empty() ? trackers[i]->track(images[k], t)
+                                                  : trackers[i]->track(images[k], t, rotations[k]);
             record(f, k, images.size(), r == 0, &runs[i]);
             if (r == 0 && !draw.empty()) {
               std::ostringstream name;
