@@ -88,8 +88,9 @@ std::vector<std::optional<Eigen::Matrix3d>> gyroRotations(const std::string& dir
                                                           const std::vector<int64_t>& stamps_ns,
                                                           const Config& config,
                                                           std::string* source) {
-  const fs::path imu_csv =
-      fs::path(dir).lexically_normal().parent_path().parent_path() / "imu0" / "data.csv";
+  fs::path data = fs::path(dir).lexically_normal();
+  if (!data.has_filename()) data = data.parent_path();  // a trailing separator
+  const fs::path imu_csv = data.parent_path().parent_path() / "imu0" / "data.csv";
   if (stamps_ns.empty() || !fs::exists(imu_csv)) {
     *source = "none (not an EuRoC mav0/cam0/data folder with imu0/data.csv beside it)";
     return {};
