@@ -59,6 +59,18 @@ TEST(Clahe, GivesCvClahesImageOnRealEuRoCFrames) {
   }
 }
 
+TEST(Clahe, RowsNotAMultipleOfEightEndInThePlainLoop) {
+  // 750 = 3 x 250 columns: each row ends with six pixels past the last group of eight.
+  Clahe clahe(3.0, 3);
+  const cv::Ptr<cv::CLAHE> reference = cv::createCLAHE(3.0, cv::Size(3, 3));
+  for (const cv::Mat& image : syntheticImages(cv::Size(750, 477))) {
+    cv::Mat expected, got;
+    reference->apply(image, expected);
+    clahe.apply(image, got);
+    EXPECT_EQ(differingPixels(got, expected), 0);
+  }
+}
+
 TEST(Clahe, ImagesTheTilesDoNotDivideGoToCvClahe) {
   // 750 and 479 are not multiples of 8: cv::CLAHE pads them itself.
   Clahe clahe(3.0, 8);

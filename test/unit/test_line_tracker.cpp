@@ -605,8 +605,11 @@ TEST(ImageUndistorter, GivesCvRemapsImageBitForBitBorderIncluded) {
   fisheye.distortion_model = "equidistant";
   fisheye.distortion_coefficients = {0.3, 0.1, -0.05, 0.01};
   cv::RNG rng(7);
+  CameraOptions odd_size = euroc;  // 749 x 479 pixels: the last three past a group of eight
+  odd_size.width = 749;
+  odd_size.height = 479;
   std::vector<int> outside_sources;
-  for (const CameraOptions& camera : {euroc, fisheye, pincushion}) {
+  for (const CameraOptions& camera : {euroc, fisheye, pincushion, odd_size}) {
     const auto model = CameraModel::create(camera);
     const cv::Size size(camera.width, camera.height);
     cv::Mat map_x(size, CV_32FC1), map_y(size, CV_32FC1);
