@@ -23,6 +23,13 @@ LinearTimeLsd::LinearTimeLsd(double scale, double sigma_scale, double quant, boo
       pyramid_downscale_(pyramid_downscale) {
   CV_Assert(scale > 0 && scale <= 1 && sigma_scale > 0 && quant > 0);
   CV_Assert(!pyramid_downscale || scale == 0.5);
+  // Most gradients are small: their directions are looked up, computed once by the same calls
+  // as the others'.
+  direction_table_.resize(kTableSide * kTableSide);
+  for (int gy = -kTableRadius; gy <= kTableRadius; ++gy)
+    for (int gx = -kTableRadius; gx <= kTableRadius; ++gx)
+      direction_table_[(gy + kTableRadius) * kTableSide + gx + kTableRadius] =
+          direction(levelLineAngle(gx, gy));
 }
 
 void LinearTimeLsd::detect(const cv::Mat& gray, std::vector<cv::Vec4f>* segments) {
@@ -57,7 +64,6 @@ void LinearTimeLsd::detect(const cv::Mat& gray, std::vector<cv::Vec4f>* segments
       5 * (std::log10(double(width_)) + std::log10(double(height_))) / 2 + std::log10(11.0);
   const std::size_t min_region = std::size_t(-log_tests / std::log10(kAlignedProbability));
 
-  used_.assign(angle_.size(), 0);
   for (int seed : seeds_) {
     if (used_[seed]) continue;
     const double region_angle = growRegion(seed);
@@ -69,17 +75,36 @@ void LinearTimeLsd::detect(const cv::Mat& gray, std::vector<cv::Vec4f>* segments
   }
 }
 
+LinearTimeLsd::Direction LinearTimeLsd::direction(float angle) {
+  // In float, as the region's running sum adds them.
+  return {angle, {std::cos(angle), std::sin(angle)}};
+}
+
+float LinearTimeLsd::levelLineAngle(int gx, int gy) {
+  // The level-line direction: the gradient turned by 90 degrees.
+  return static_cast<float>(cv::fastAtan2(float(gx), float(-gy)) * kDegToRad);
+}
+
 void LinearTimeLsd::computeGradient() {
   const std::size_t n = std::size_t(width_) * height_;
   angle_.assign(n, kUndefined);
   gradient_.assign(n, 0.0f);
+  // Pixels without a direction can join no region: marked used, growRegion skips them in the
+  // same test as the pixels already taken.
+  used_.assign(n, 1);
+  cos_sin_.resize(n);  // read only where a direction is
+  candidates_.clear();
+  max_gradient_ = 0.0f;
   // Compared squared, so that only pixels above the threshold need a square root.
   const double min_norm2 = 4.0 * threshold_ * threshold_;
   for (int y = 0; y + 1 < height_; ++y) {
     const uint8_t* row = scaled_.ptr<uint8_t>(y);
     const uint8_t* next = scaled_.ptr<uint8_t>(y + 1);
-    float* angle = &angle_[std::size_t(y) * width_];
-    float* gradient = &gradient_[std::size_t(y) * width_];
+    const int offset = y * width_;
+    float* angle = &angle_[offset];
+    float* gradient = &gradient_[offset];
+    uint8_t* used = &used_[offset];
+    CosSin* cos_sin = &cos_sin_[offset];
     for (int x = 0; x + 1 < width_; ++x) {
       // 2x2 differences; the gradient belongs to the square's centre, hence the +0.5 above.
       const int diagonal = next[x + 1] - row[x];
@@ -89,64 +114,84 @@ void LinearTimeLsd::computeGradient() {
       const int norm2 = gx * gx + gy * gy;
       if (norm2 <= min_norm2) continue;
       gradient[x] = static_cast<float>(std::sqrt(norm2 / 4.0));
-      // The level-line direction: the gradient turned by 90 degrees.
-      angle[x] = static_cast<float>(cv::fastAtan2(float(gx), float(-gy)) * kDegToRad);
+      max_gradient_ = std::max(max_gradient_, gradient[x]);
+      const Direction d =
+          std::abs(gx) <= kTableRadius && std::abs(gy) <= kTableRadius
+              ? direction_table_[(gy + kTableRadius) * kTableSide + gx + kTableRadius]
+              : direction(levelLineAngle(gx, gy));
+      angle[x] = d.angle;
+      cos_sin[x] = d.cos_sin;
+      used[x] = 0;
+      candidates_.push_back(offset + x);
     }
   }
 }
 
 void LinearTimeLsd::orderSeeds() {
-  float max_gradient = 0;
-  for (float g : gradient_) max_gradient = std::max(max_gradient, g);
   seeds_.clear();
-  if (max_gradient <= 0) return;
-  const double bin_per_gradient = double(kGradientBins - 1) / max_gradient;
-  // Counting sort by bin, strongest first: bin_count_[b] becomes the first slot of bin b.
+  if (max_gradient_ <= 0) return;
+  const double bin_per_gradient = double(kGradientBins - 1) / max_gradient_;
+  // Counting sort by bin, strongest first: bin_count_[b] becomes the first slot of bin b. The
+  // candidates are in raster order, so each bin keeps it.
   bin_count_.assign(kGradientBins + 1, 0);
-  auto binOf = [&](float g) {
-    return kGradientBins - 1 - std::min(kGradientBins - 1, int(g * bin_per_gradient));
-  };
-  std::size_t candidates = 0;
-  for (std::size_t i = 0; i < angle_.size(); ++i)
-    if (angle_[i] != kUndefined) {
-      ++bin_count_[binOf(gradient_[i]) + 1];
-      ++candidates;
-    }
+  seed_bin_.resize(candidates_.size());
+  for (std::size_t i = 0; i < candidates_.size(); ++i) {
+    const float g = gradient_[candidates_[i]];
+    seed_bin_[i] = kGradientBins - 1 - std::min(kGradientBins - 1, int(g * bin_per_gradient));
+    ++bin_count_[seed_bin_[i] + 1];
+  }
   for (int b = 0; b < kGradientBins; ++b) bin_count_[b + 1] += bin_count_[b];
-  seeds_.resize(candidates);
-  for (std::size_t i = 0; i < angle_.size(); ++i)
-    if (angle_[i] != kUndefined) seeds_[bin_count_[binOf(gradient_[i])]++] = static_cast<int>(i);
-}
-
-bool LinearTimeLsd::aligned(int index, double angle) const {
-  const float a = angle_[index];
-  if (a == kUndefined) return false;
-  double d = std::fabs(angle - a);
-  if (d > 1.5 * CV_PI) d = std::fabs(d - 2 * CV_PI);
-  return d <= kTolerance;
+  seeds_.resize(candidates_.size());
+  for (std::size_t i = 0; i < candidates_.size(); ++i)
+    seeds_[bin_count_[seed_bin_[i]]++] = candidates_[i];
 }
 
 double LinearTimeLsd::growRegion(int seed) {
+  // Local copies: the byte stores to `used` could alias the members, which the compiler
+  // would otherwise load again for every neighbour.
+  uint8_t* const used = used_.data();
+  const float* const angle = angle_.data();
+  const float* const gradient = gradient_.data();
+  const CosSin* const cos_sin = cos_sin_.data();
+  const int width = width_, height = height_;
   region_.clear();
-  used_[seed] = 1;
-  double region_angle = angle_[seed];
-  region_.push_back({seed % width_, seed / width_, angle_[seed], gradient_[seed]});
+  used[seed] = 1;
+  double region_angle = angle[seed];
+  region_.push_back({seed % width, seed / width, angle[seed], gradient[seed]});
   float sum_dx = static_cast<float>(std::cos(region_angle));
   float sum_dy = static_cast<float>(std::sin(region_angle));
+  auto visit = [&](int k, int x, int y) {
+    if (used[k]) return;
+    // Within the tolerance of the region's direction, modulo 2 pi.
+    const float a = angle[k];
+    double d = std::fabs(region_angle - a);
+    if (d > 1.5 * CV_PI) d = std::fabs(d - 2 * CV_PI);
+    if (!(d <= kTolerance)) return;
+    used[k] = 1;
+    region_.push_back({x, y, a, gradient[k]});
+    sum_dx += cos_sin[k].cos;
+    sum_dy += cos_sin[k].sin;
+    region_angle = cv::fastAtan2(sum_dy, sum_dx) * kDegToRad;
+  };
   for (std::size_t i = 0; i < region_.size(); ++i) {
     const int cx = region_[i].x, cy = region_[i].y;
-    const int x0 = std::max(cx - 1, 0), x1 = std::min(cx + 1, width_ - 1);
-    const int y0 = std::max(cy - 1, 0), y1 = std::min(cy + 1, height_ - 1);
+    if (cx > 0 && cy > 0 && cx + 1 < width && cy + 1 < height) {
+      // The 8 neighbours in raster order (the centre is used), without the image's bounds.
+      const int c = cy * width + cx;
+      visit(c - width - 1, cx - 1, cy - 1);
+      visit(c - width, cx, cy - 1);
+      visit(c - width + 1, cx + 1, cy - 1);
+      visit(c - 1, cx - 1, cy);
+      visit(c + 1, cx + 1, cy);
+      visit(c + width - 1, cx - 1, cy + 1);
+      visit(c + width, cx, cy + 1);
+      visit(c + width + 1, cx + 1, cy + 1);
+      continue;
+    }
+    const int x0 = std::max(cx - 1, 0), x1 = std::min(cx + 1, width - 1);
+    const int y0 = std::max(cy - 1, 0), y1 = std::min(cy + 1, height - 1);
     for (int y = y0; y <= y1; ++y)
-      for (int x = x0; x <= x1; ++x) {
-        const int k = y * width_ + x;
-        if (used_[k] || !aligned(k, region_angle)) continue;
-        used_[k] = 1;
-        region_.push_back({x, y, angle_[k], gradient_[k]});
-        sum_dx += std::cos(angle_[k]);
-        sum_dy += std::sin(angle_[k]);
-        region_angle = cv::fastAtan2(sum_dy, sum_dx) * kDegToRad;
-      }
+      for (int x = x0; x <= x1; ++x) visit(y * width + x, x, y);
   }
   return region_angle;
 }

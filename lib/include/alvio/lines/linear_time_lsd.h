@@ -35,6 +35,17 @@ class LinearTimeLsd {
     float angle, gradient;
   };
 
+  struct CosSin {
+    float cos, sin;
+  };
+  struct Direction {
+    float angle;
+    CosSin cos_sin;
+  };
+
+  /// The level-line angle [rad] of the 2x2 gradient (gx, gy): the gradient turned by 90 deg.
+  static float levelLineAngle(int gx, int gy);
+  static Direction direction(float angle);
   void computeGradient();
   void orderSeeds();
   /// Grows the region of pixels aligned with the seed's running mean direction (8-connected).
@@ -43,7 +54,6 @@ class LinearTimeLsd {
   /// The region's rectangle: its gradient-weighted centre, its axis of least inertia, and the
   /// extreme projections on that axis, as a segment in scaled-image pixels.
   cv::Vec4d regionToSegment(double region_angle) const;
-  bool aligned(int index, double angle) const;
 
   double scale_, sigma_scale_, threshold_;
   bool pyramid_downscale_;
@@ -51,8 +61,14 @@ class LinearTimeLsd {
   int width_ = 0, height_ = 0;
   std::vector<float> angle_;     // gradient direction [rad], or kUndefined
   std::vector<float> gradient_;  // gradient norm
-  std::vector<uint8_t> used_;
-  std::vector<int> seeds_;  // pixel indices, strongest gradient bin first
+  std::vector<uint8_t> used_;    // taken by a region, or without a direction
+  std::vector<int> candidates_;  // pixels with a direction, in raster order
+  std::vector<int> seed_bin_;    // each candidate's gradient bin
+  float max_gradient_ = 0.0f;
+  static constexpr int kTableRadius = 63, kTableSide = 2 * kTableRadius + 1;
+  std::vector<Direction> direction_table_;  // for |gx|, |gy| <= kTableRadius
+  std::vector<CosSin> cos_sin_;             // of angle_, where it is defined
+  std::vector<int> seeds_;                  // pixel indices, strongest gradient bin first
   std::vector<int> bin_count_;
   std::vector<RegionPixel> region_;
 };
