@@ -299,14 +299,18 @@ std::vector<OpticalFlowLineTracker::Track> OpticalFlowLineTracker::match(
   const auto& f = options_.flow;
   // Candidates: the K best detections per prediction that pass angle, distance and overlap.
   const double max_angle = f.max_angle_deg * kDegToRad;
+  // Each segment's angle once, not once per pair.
+  std::vector<double> detection_angles(detections.size());
+  for (std::size_t j = 0; j < detections.size(); ++j) detection_angles[j] = detections[j].angle();
   std::vector<Candidate> candidates;
   for (std::size_t i = 0; i < predictions_.size(); ++i) {
     if (!predictions_[i].valid) continue;
     const LineSegment& pred = predictions_[i].segment;
+    const double pred_angle = pred.angle();
     std::vector<Candidate> own;
     for (std::size_t j = 0; j < detections.size(); ++j) {
       const LineSegment& det = detections[j];
-      const double dangle = angleDifference(pred.angle(), det.angle());
+      const double dangle = angleDifference(pred_angle, detection_angles[j]);
       if (dangle > max_angle) continue;
       const double d0 = pred.distanceToLine(det.start), d1 = pred.distanceToLine(det.end);
       if (std::max(d0, d1) > f.max_line_distance_px) continue;
