@@ -7,6 +7,7 @@
 #include <unordered_map>
 
 #include "alvio/common/error.h"
+#include "alvio/frontend/rotated_pixels.h"
 
 namespace alvio {
 
@@ -103,16 +104,9 @@ void PointTracker::flowForwardBackward(const std::vector<cv::Mat>& prev_pyramid,
 
 std::vector<cv::Point2f> PointTracker::rotated(const Eigen::Matrix3d& R,
                                                const std::vector<cv::Point2f>& px) const {
-  std::vector<cv::Point2f> moved(px.size());
-  for (std::size_t i = 0; i < px.size(); ++i) {
-    Eigen::Vector2d out;
-    // A corner turned behind the camera keeps its position: KLT will lose it either way.
-    if (camera_->project(R * camera_->backProject({px[i].x, px[i].y}), &out))
-      moved[i] = cv::Point2f(static_cast<float>(out.x()), static_cast<float>(out.y()));
-    else
-      moved[i] = px[i];
-  }
-  return moved;
+  return rotatedPixels(
+      R, px, [&](const Eigen::Vector2d& p) -> Eigen::Vector3d { return camera_->backProject(p); },
+      [&](const Eigen::Vector3d& ray, Eigen::Vector2d* out) { return camera_->project(ray, out); });
 }
 
 FeatureFrame PointTracker::track(const cv::Mat& gray, int64_t t_ns, FrameTiming* timing,

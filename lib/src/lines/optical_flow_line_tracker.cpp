@@ -5,6 +5,8 @@
 #include <cmath>
 #include <opencv2/video/tracking.hpp>
 
+#include "alvio/frontend/rotated_pixels.h"
+
 namespace alvio {
 namespace {
 constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
@@ -168,16 +170,16 @@ void OpticalFlowLineTracker::predictFromRotation(const std::vector<cv::Mat>& pyr
   const std::size_t n = static_cast<std::size_t>(f.samples_per_line);
   // Started where the gyroscope's rotation puts them (in the pinhole image the homography
   // K R K^-1), samples need fewer levels; those that fail there try again on all levels.
-  const Eigen::Matrix3d& R = *rotationSincePrevious();
-  std::vector<cv::Point2f> predicted(samples.size());
-  for (std::size_t i = 0; i < samples.size(); ++i) {
-    const Eigen::Vector3d r =
-        R * undistorter().pixelToNormalised({samples[i].x, samples[i].y}).homogeneous();
-    predicted[i] = samples[i];  // turned behind the camera: KLT loses it either way
-    if (r.z() <= 0) continue;
-    const Eigen::Vector2d px = undistorter().normalisedToPixel(r.hnormalized());
-    predicted[i] = cv::Point2f(static_cast<float>(px.x()), static_cast<float>(px.y()));
-  }
+  const std::vector<cv::Point2f> predicted = rotatedPixels(
+      *rotationSincePrevious(), samples,
+      [&](const Eigen::Vector2d& p) -> Eigen::Vector3d {
+        return undistorter().pixelToNormalised(p).homogeneous();
+      },
+      [&](const Eigen::Vector3d& ray, Eigen::Vector2d* out) {
+        if (ray.z() <= 0) return false;
+        *out = undistorter().normalisedToPixel(ray.hnormalized());
+        return true;
+      });
   std::vector<cv::Point2f> moved = predicted;
   std::vector<uchar> status;
   cv::calcOpticalFlowPyrLK(prev_pyramid_, pyramid, samples, moved, status, cv::noArray(),
