@@ -12,6 +12,7 @@
 #include "alvio/config/config.h"
 #include "alvio/frontend/gyro_rotation.h"
 #include "alvio/frontend/point_tracker.h"
+#include "alvio/frontend/rotated_pixels.h"
 #include "alvio/lines/optical_flow_line_tracker.h"
 #include "synthetic_line_scene.h"
 #include "test_support.h"
@@ -103,6 +104,38 @@ TEST(GyroRotation, NothingUnlessTheSamplesReachBothTimes) {
   ASSERT_TRUE(gyro.cameraRotation(160'000'000, 190'000'000).has_value());
   EXPECT_TRUE(gyro.cameraRotation(160'000'000, 190'000'000)->isApprox(before, 1e-15));
   EXPECT_FALSE(gyro.cameraRotation(150'000'000, 190'000'000).has_value());
+}
+
+TEST(RotatedPixels, MovesPixelsAsTheRotationDoesAndKeepsThoseTurnedBehind) {
+  // A pinhole camera (f 400, centre (320, 240)): turned 30 degrees about its optical axis a
+  // pixel turns about the centre; turned 120 degrees about x, a point ahead goes behind.
+  const double f = 400, cx = 320, cy = 240;
+  const auto bearing = [&](const Eigen::Vector2d& p) -> Eigen::Vector3d {
+    return Eigen::Vector3d((p.x() - cx) / f, (p.y() - cy) / f, 1.0);
+  };
+  const auto project = [&](const Eigen::Vector3d& r, Eigen::Vector2d* out) {
+    if (r.z() <= 0) return false;
+    *out = Eigen::Vector2d(f * r.x() / r.z() + cx, f * r.y() / r.z() + cy);
+    return true;
+  };
+  const double a = 30.0 * M_PI / 180.0;
+  const Eigen::Matrix3d roll = Eigen::AngleAxisd(a, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const std::vector<cv::Point2f> px{{420, 240}, {320, 140}, {320, 240}};
+  const std::vector<cv::Point2f> moved = rotatedPixels(roll, px, bearing, project);
+  ASSERT_EQ(moved.size(), px.size());
+  EXPECT_NEAR(moved[0].x, 320 + 100 * std::cos(a), 1e-3);
+  EXPECT_NEAR(moved[0].y, 240 + 100 * std::sin(a), 1e-3);
+  EXPECT_NEAR(moved[1].x, 320 + 100 * std::sin(a), 1e-3);
+  EXPECT_NEAR(moved[1].y, 240 - 100 * std::cos(a), 1e-3);
+  EXPECT_NEAR(moved[2].x, 320, 1e-4);
+  EXPECT_NEAR(moved[2].y, 240, 1e-4);
+  const Eigen::Matrix3d over =
+      Eigen::AngleAxisd(120.0 * M_PI / 180.0, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  const std::vector<cv::Point2f> behind = rotatedPixels(over, px, bearing, project);
+  for (std::size_t i = 0; i < px.size(); ++i) {
+    EXPECT_EQ(behind[i].x, px[i].x);
+    EXPECT_EQ(behind[i].y, px[i].y);
+  }
 }
 
 TEST(PointTracker, TheGyroscopesRotationCarriesCornersThroughAFastTurn) {
