@@ -45,6 +45,7 @@ class LinearTimeLsd {
 
   /// The level-line angle [rad] of the 2x2 gradient (gx, gy): the gradient turned by 90 deg.
   static float levelLineAngle(int gx, int gy);
+  /// The angle with its cosine and sine in float, as region growth sums them.
   static Direction direction(float angle);
   void computeGradient();
   void orderSeeds();
