@@ -33,6 +33,15 @@ bool samplePatch(const cv::Mat& image, const cv::Point2f& p, int side, float* ou
   return true;
 }
 
+// The upper triangle of g g^T (K x K, row by row) added to `upper`.
+constexpr int kUpperSize = 21;  // 6 x 6
+template <int K>
+void addOuterUpper(const double* g, double* upper) {
+  int t = 0;
+  for (int i = 0; i < K; ++i)
+    for (int j = i; j < K; ++j) upper[t++] += g[i] * g[j];
+}
+
 }  // namespace
 
 PatchAnchors::PatchAnchors(const PatchAnchorOptions& options)
@@ -74,7 +83,12 @@ bool PatchAnchors::anchor(int id, const cv::Mat& image, const cv::Point2f& p) {
     }
   const float mean = static_cast<float>(sum / (n * n));
   double ss = 0;
-  Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
+  // The normal matrix's upper triangle, mirrored after: each entry sums the same products in
+  // the same order as the whole outer product g g^T, in about half the work.
+  double upper[kUpperSize] = {};
+  const auto add_outer = k_params_ == 6   ? &addOuterUpper<6>
+                         : k_params_ == 4 ? &addOuterUpper<4>
+                                          : &addOuterUpper<2>;
   patch.sum_sd.setZero();
   patch.sum_sd_t.setZero();
   for (int k = 0; k < n * n; ++k) {
@@ -82,10 +96,13 @@ bool PatchAnchors::anchor(int id, const cv::Mat& image, const cv::Point2f& p) {
     ss += patch.values[k] * patch.values[k];
     Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
     for (int i = 0; i < k_params_; ++i) g[i] = patch.sd[i][k];
-    H.noalias() += g * g.transpose();
+    add_outer(g.data(), upper);
     patch.sum_sd += g;
     patch.sum_sd_t += g * patch.values[k];
   }
+  Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
+  for (int i = 0, t = 0; i < k_params_; ++i)
+    for (int j = i; j < k_params_; ++j, ++t) H(i, j) = H(j, i) = upper[t];
   const Eigen::Matrix2d H2 = H.topLeftCorner<2, 2>();
   const double trace = H2.trace();
   if (!(H2.determinant() > 1e-6 * trace * trace) || ss <= 0) return false;  // no 2D texture
