@@ -12,7 +12,6 @@ constexpr double kTolerance = CV_PI * kAngleToleranceDeg / 180.0;
 // Probability that a pixel of noise is aligned within the tolerance.
 constexpr double kAlignedProbability = kAngleToleranceDeg / 180.0;
 constexpr int kGradientBins = 1024;
-constexpr float kUndefined = -1024.0f;
 constexpr double kDegToRad = CV_PI / 180.0;
 }  // namespace
 
@@ -87,12 +86,13 @@ float LinearTimeLsd::levelLineAngle(int gx, int gy) {
 
 void LinearTimeLsd::computeGradient() {
   const std::size_t n = std::size_t(width_) * height_;
-  angle_.assign(n, kUndefined);
-  gradient_.assign(n, 0.0f);
   // Pixels without a direction can join no region: marked used, growRegion skips them in the
-  // same test as the pixels already taken.
+  // same test as the pixels already taken. The per-pixel values are read only where a
+  // direction is, so they need no clearing.
   used_.assign(n, 1);
-  cos_sin_.resize(n);  // read only where a direction is
+  angle_.resize(n);
+  gradient_.resize(n);
+  cos_sin_.resize(n);
   candidates_.clear();
   max_gradient_ = 0.0f;
   // Compared squared, so that only pixels above the threshold need a square root.

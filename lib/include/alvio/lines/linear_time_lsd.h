@@ -60,7 +60,8 @@ class LinearTimeLsd {
   bool pyramid_downscale_;
   cv::Mat blurred_, scaled_;
   int width_ = 0, height_ = 0;
-  std::vector<float> angle_;     // gradient direction [rad], or kUndefined
+  // Per pixel, defined where used_ is 0 after computeGradient.
+  std::vector<float> angle_;     // level-line direction [rad]
   std::vector<float> gradient_;  // gradient norm
   std::vector<uint8_t> used_;    // taken by a region, or without a direction
   std::vector<int> candidates_;  // pixels with a direction, in raster order
@@ -68,7 +69,7 @@ class LinearTimeLsd {
   float max_gradient_ = 0.0f;
   static constexpr int kTableRadius = 63, kTableSide = 2 * kTableRadius + 1;
   std::vector<Direction> direction_table_;  // for |gx|, |gy| <= kTableRadius
-  std::vector<CosSin> cos_sin_;             // of angle_, where it is defined
+  std::vector<CosSin> cos_sin_;             // of angle_
   std::vector<int> seeds_;                  // pixel indices, strongest gradient bin first
   std::vector<int> bin_count_;
   std::vector<RegionPixel> region_;
