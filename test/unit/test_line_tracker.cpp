@@ -198,15 +198,32 @@ Agreement compareOnImages(const std::vector<cv::Mat>& images, const Detect& firs
   }
   return n;
 }
-// The same on ten of the real EuRoC frames.
-Agreement compareOnRealFrames(const std::vector<std::string>& files, const Detect& first,
-                              const Detect& second, const Counterpart& counterpart) {
+// Ten of the real EuRoC frames, spread over the list.
+std::vector<cv::Mat> tenRealFrames(const std::vector<std::string>& files) {
   std::vector<cv::Mat> images;
   for (std::size_t i = 0; i < files.size(); i += files.size() / 10) {
     images.push_back(cv::imread(files[i], cv::IMREAD_GRAYSCALE));
     EXPECT_FALSE(images.back().empty()) << files[i];
   }
-  return compareOnImages(images, first, second, counterpart);
+  return images;
+}
+// alvio's LSD and OpenCV's without refinement, with the default options, must find nearly all
+// of each other's segments on `images`.
+void expectOpenCvsSegments(const std::vector<cv::Mat>& images) {
+  const LineDetectorOptions o;  // the defaults: scale 0.5, sigma 0.6, quant 2
+  const auto opencv = cv::createLineSegmentDetector(cv::LSD_REFINE_NONE, o.lsd_scale,
+                                                    o.lsd_sigma_scale, o.lsd_quant);
+  LinearTimeLsd linear(o.lsd_scale, o.lsd_sigma_scale, o.lsd_quant);
+  const Agreement n = compareOnImages(
+      images,
+      [&](const cv::Mat& image, std::vector<cv::Vec4f>* out) { opencv->detect(image, *out); },
+      [&](const cv::Mat& image, std::vector<cv::Vec4f>* out) { linear.detect(image, out); },
+      hasCounterpart);
+  std::cout << n.first_found << " of OpenCV's " << n.first << " segments found, " << n.second_found
+            << " of ours " << n.second << " found by OpenCV\n";
+  ASSERT_GT(n.first, 500);
+  EXPECT_GE(n.first_found, 0.98 * n.first);
+  EXPECT_GE(n.second_found, 0.98 * n.second);
 }
 // Random quadrilaterals from faint (4 grey levels) to strong contrast (200) over sensor noise:
 // gradients both inside and beyond the detector's table of small gradients.
@@ -241,38 +258,12 @@ TEST(LinearTimeLsd, FindsOpenCvsSegmentsOnRealEuRoCFrames) {
   const std::vector<std::string> files = test::sharedEurocImages();
   if (files.empty()) GTEST_SKIP() << "../shared/data not found: no real EuRoC frames to compare on";
   ASSERT_GE(files.size(), 10u);
-  const LineDetectorOptions o;  // the defaults: scale 0.5, sigma 0.6, quant 2
-  const auto opencv = cv::createLineSegmentDetector(cv::LSD_REFINE_NONE, o.lsd_scale,
-                                                    o.lsd_sigma_scale, o.lsd_quant);
-  LinearTimeLsd linear(o.lsd_scale, o.lsd_sigma_scale, o.lsd_quant);
-  const Agreement n = compareOnRealFrames(
-      files,
-      [&](const cv::Mat& image, std::vector<cv::Vec4f>* out) { opencv->detect(image, *out); },
-      [&](const cv::Mat& image, std::vector<cv::Vec4f>* out) { linear.detect(image, out); },
-      hasCounterpart);
-  std::cout << n.first_found << " of OpenCV's " << n.first << " segments found, " << n.second_found
-            << " of ours " << n.second << " found by OpenCV\n";
-  ASSERT_GT(n.first, 500);
-  EXPECT_GE(n.first_found, 0.98 * n.first);
-  EXPECT_GE(n.second_found, 0.98 * n.second);
+  expectOpenCvsSegments(tenRealFrames(files));
 }
 
 TEST(LinearTimeLsd, FindsOpenCvsSegmentsOnSyntheticImages) {
   // As on the real frames, without ../shared, and with faint edges too.
-  const LineDetectorOptions o;
-  const auto opencv = cv::createLineSegmentDetector(cv::LSD_REFINE_NONE, o.lsd_scale,
-                                                    o.lsd_sigma_scale, o.lsd_quant);
-  LinearTimeLsd linear(o.lsd_scale, o.lsd_sigma_scale, o.lsd_quant);
-  const Agreement n = compareOnImages(
-      quadrilateralImages(10),
-      [&](const cv::Mat& image, std::vector<cv::Vec4f>* out) { opencv->detect(image, *out); },
-      [&](const cv::Mat& image, std::vector<cv::Vec4f>* out) { linear.detect(image, out); },
-      hasCounterpart);
-  std::cout << n.first_found << " of OpenCV's " << n.first << " segments found, " << n.second_found
-            << " of ours " << n.second << " found by OpenCV\n";
-  ASSERT_GT(n.first, 500);
-  EXPECT_GE(n.first_found, 0.98 * n.first);
-  EXPECT_GE(n.second_found, 0.98 * n.second);
+  expectOpenCvsSegments(quadrilateralImages(10));
 }
 
 TEST(LinearTimeLsd, PyramidDownscaleFindsTheBlurredImagesLines) {
@@ -285,8 +276,9 @@ TEST(LinearTimeLsd, PyramidDownscaleFindsTheBlurredImagesLines) {
   const LineDetectorOptions o;
   LinearTimeLsd blurred(0.5, o.lsd_sigma_scale, o.lsd_quant);
   LinearTimeLsd pyramid(0.5, o.lsd_sigma_scale, o.lsd_quant, true);
-  const Agreement n = compareOnRealFrames(
-      files, [&](const cv::Mat& image, std::vector<cv::Vec4f>* out) { blurred.detect(image, out); },
+  const Agreement n = compareOnImages(
+      tenRealFrames(files),
+      [&](const cv::Mat& image, std::vector<cv::Vec4f>* out) { blurred.detect(image, out); },
       [&](const cv::Mat& image, std::vector<cv::Vec4f>* out) { pyramid.detect(image, out); },
       hasCollinearCounterpart);
   std::cout << n.first_found << " of the blurred image's " << n.first << " segments found, "
