@@ -2,6 +2,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 
 #include "alvio/common/arg_parser.h"
 #include "alvio/common/error.h"
@@ -22,6 +23,8 @@ int main(int argc, char** argv) {
   args.option("max-dt", "association window in seconds", "0.02");
   args.option("gt-format", "auto | tum | euroc | vins", "auto");
   args.option("est-format", "auto | tum | euroc | vins", "auto");
+  args.option("against",
+              "a second estimate of the same sequence: how much of the two runs' error is shared");
   args.option("json", "write all numbers to this JSON file");
   args.option("plot", "write PNG plots (and the per-pose CSV) into this folder");
   args.flag("strict", "fail on unsorted or duplicate timestamps instead of warning and dropping");
@@ -38,9 +41,17 @@ int main(int argc, char** argv) {
     const Trajectory est =
         readTrajectory(args.get("est"), parseTrajectoryFormat(args.get("est-format")), order);
     const EvaluationResult result = evaluateTrajectory(est, gt, options);
-    if (args.isSet("json"))
-      writeFileAtomically(args.get("json"),
-                          evaluationToJson(result, options, args.get("gt"), args.get("est")));
+    std::optional<SharedError> shared;
+    if (args.isSet("against")) {
+      const Trajectory other =
+          readTrajectory(args.get("against"), parseTrajectoryFormat(args.get("est-format")), order);
+      shared = sharedError(result, evaluateTrajectory(other, gt, options), options.max_dt);
+    }
+    if (args.isSet("json")) {
+      std::string json = evaluationToJson(result, options, args.get("gt"), args.get("est"));
+      if (shared) json = addSharedErrorToJson(json, *shared, args.get("against"));
+      writeFileAtomically(args.get("json"), json);
+    }
     if (args.isSet("plot")) {
       namespace fs = std::filesystem;
       const fs::path dir = args.get("plot");
@@ -52,6 +63,8 @@ int main(int argc, char** argv) {
         logWarn("plotting failed (is python3-matplotlib installed?); data is in ",
                 (dir / "ate_pairs.csv").string());
     }
+    // The shared error first: the table ends with the machine-readable ATE_RMSE line.
+    if (shared) std::cout << formatSharedErrorText(*shared, args.get("against"));
     std::cout << formatEvaluationText(result, options);
     return 0;
   } catch (const Error& e) {

@@ -5,6 +5,8 @@
 #include <fstream>
 #include <random>
 
+#include "alvio/common/error.h"
+#include "alvio/eval/shared_error.h"
 #include "alvio/eval/trajectory_evaluation.h"
 #include "alvio/io/trajectory_io.h"
 #include "test_support.h"
@@ -253,4 +255,100 @@ TEST(SharedTrajectories, VinsMonoMh05NoLoopIsAbout30cm) {
     // Published: 0.302 m; independent runs differ by several centimetres.
     EXPECT_NEAR(r.ate_translation_m.rmse, 0.30, 0.06) << est_path;
   }
+}
+
+namespace {
+// gt with an error added to every position: err(i) for pose i.
+template <class Error>
+Trajectory withError(const Trajectory& gt, Error err) {
+  Trajectory out = gt;
+  for (std::size_t i = 0; i < out.size(); ++i) out[i].p += err(i);
+  return out;
+}
+}  // namespace
+
+TEST(SharedError, SplitsTwoRunsErrorsIntoWhatTheyShareAndWhatDiffers) {
+  const Trajectory gt = syntheticPath();
+  auto common = [](std::size_t i) {
+    const double s = 0.05 * i;
+    return Eigen::Vector3d(0.05 * std::sin(0.5 * s), 0.03 * std::cos(0.3 * s),
+                           0.02 * std::sin(0.9 * s));
+  };
+  auto own = [](std::size_t i) {  // along x and y only
+    const double s = 0.05 * i;
+    return Eigen::Vector3d(0.02 * std::cos(1.7 * s), 0.01 * std::sin(2.3 * s), 0.0);
+  };
+  const Trajectory a = withError(gt, [&](std::size_t i) {
+    Eigen::Vector3d e = common(i) + own(i);
+    return e;
+  });
+  // The second run lacks every third pose and stamps 1 ms late: pairing by index would fail.
+  Trajectory b;
+  const Trajectory b_all = withError(gt, [&](std::size_t i) {
+    Eigen::Vector3d e = common(i) - own(i);
+    return e;
+  });
+  for (std::size_t i = 0; i < b_all.size(); ++i)
+    if (i % 3 != 2) {
+      b.push_back(b_all[i]);
+      b.back().t += 0.001;
+    }
+  EvaluationOptions o;
+  o.alignment = AlignmentMode::kNone;  // the errors stay exactly the ones added
+  const SharedError s =
+      sharedError(evaluateTrajectory(a, gt, o), evaluateTrajectory(b, gt, o), 0.01);
+
+  double sq_c = 0, sq_d = 0, sq_a = 0;
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < gt.size(); ++i) {
+    if (i % 3 == 2) continue;
+    sq_c += common(i).squaredNorm();
+    sq_d += own(i).squaredNorm();
+    sq_a += (common(i) + own(i)).squaredNorm();
+    ++n;
+  }
+  EXPECT_EQ(s.matched, n);
+  EXPECT_NEAR(s.rms_a, std::sqrt(sq_a / n), 1e-9);
+  EXPECT_NEAR(s.rms_shared, std::sqrt(sq_c / n), 1e-9);
+  EXPECT_NEAR(s.rms_difference, 2 * std::sqrt(sq_d / n), 1e-9);
+  EXPECT_NEAR(s.shared_fraction, sq_c / (sq_c + sq_d), 1e-9);
+  EXPECT_GT(s.shared_fraction, 0.5);
+  EXPECT_LT(s.shared_fraction, 0.95);
+  // z carries the common error alone.
+  EXPECT_NEAR(s.axis_correlation.z(), 1.0, 1e-9);
+  EXPECT_GT(s.axis_correlation.y(), 0.5);  // 0.03 shared against 0.01 own
+
+  // Opposite errors share nothing; the same error is all shared.
+  const Trajectory plus = withError(gt, own);
+  const Trajectory minus = withError(gt, [&](std::size_t i) {
+    Eigen::Vector3d e = -own(i);
+    return e;
+  });
+  const SharedError opposite =
+      sharedError(evaluateTrajectory(plus, gt, o), evaluateTrajectory(minus, gt, o), 0.01);
+  EXPECT_NEAR(opposite.shared_fraction, 0.0, 1e-12);
+  EXPECT_NEAR(opposite.axis_correlation.x(), -1.0, 1e-9);
+  const SharedError same =
+      sharedError(evaluateTrajectory(plus, gt, o), evaluateTrajectory(plus, gt, o), 0.01);
+  EXPECT_NEAR(same.shared_fraction, 1.0, 1e-12);
+  EXPECT_NEAR(same.rms_difference, 0.0, 1e-12);
+  EXPECT_NEAR(same.axis_correlation.x(), 1.0, 1e-9);
+}
+
+TEST(SharedError, EachRunIsAlignedOnItsOwnAndTooFewCommonTimesIsAnError) {
+  const Trajectory gt = syntheticPath();
+  const Trajectory a =
+      transformed(gt, 1.0, Eigen::Matrix3d(Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitZ())),
+                  Eigen::Vector3d(1, 2, 3));
+  const EvaluationOptions o;  // SE(3): a is the truth in another frame
+  const EvaluationResult ra = evaluateTrajectory(a, gt, o);
+  const SharedError s = sharedError(ra, evaluateTrajectory(gt, gt, o), 0.01);
+  EXPECT_NEAR(s.rms_a, ra.ate_translation_m.rmse, 1e-12);
+  EXPECT_LT(s.rms_a, 1e-9);
+  EXPECT_LT(s.rms_difference, 1e-9);
+
+  Trajectory late = gt;
+  for (auto& p : late) p.t += 1000;
+  Trajectory late_gt = late;
+  EXPECT_THROW(sharedError(ra, evaluateTrajectory(late, late_gt, o), 0.01), Error);
 }

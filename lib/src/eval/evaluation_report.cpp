@@ -85,4 +85,32 @@ void writeEvaluationCsv(const std::string& path, const EvaluationResult& r) {
   writeFileAtomically(path, text);
 }
 
+std::string formatSharedErrorText(const SharedError& s, const std::string& against_path) {
+  char buf[512];
+  std::snprintf(buf, sizeof(buf),
+                "against %s, %zu poses at the same times:\n"
+                "  ATE [m]: this run %.4f, the other %.4f; their errors differ by %.4f (rms)\n"
+                "  shared error %.4f m rms, %.1f %% of the two runs' squared error; "
+                "correlation along x / y / z %.2f / %.2f / %.2f\n",
+                against_path.c_str(), s.matched, s.rms_a, s.rms_b, s.rms_difference,
+                s.rms_shared, 100 * s.shared_fraction, s.axis_correlation.x(),
+                s.axis_correlation.y(), s.axis_correlation.z());
+  return buf;
+}
+
+std::string addSharedErrorToJson(const std::string& json, const SharedError& s,
+                                 const std::string& against_path) {
+  nlohmann::json j = nlohmann::json::parse(json);
+  j["shared_error"] = {{"against", against_path},
+                       {"matched", s.matched},
+                       {"rms_m", s.rms_a},
+                       {"against_rms_m", s.rms_b},
+                       {"difference_rms_m", s.rms_difference},
+                       {"shared_rms_m", s.rms_shared},
+                       {"shared_fraction", s.shared_fraction},
+                       {"axis_correlation",
+                        {s.axis_correlation.x(), s.axis_correlation.y(), s.axis_correlation.z()}}};
+  return j.dump(2) + "\n";
+}
+
 }  // namespace alvio
