@@ -10,18 +10,26 @@ namespace alvio {
 
 double TrackSurface::expected(double x, double y) const {
   const double u = x / width - 0.5, v = y / height - 0.5;
+  // Each power once (the same std::pow values as per term): the estimator asks for every
+  // landmark several times a frame.
+  double pu[kMaxDegree + 1], pv[kMaxDegree + 1];
+  for (int n = 0; n <= degree; ++n) {
+    pu[n] = std::pow(u, n);
+    pv[n] = std::pow(v, n);
+  }
   double sum = 0;
   std::size_t k = 0;
   for (int total = 0; total <= degree; ++total)
-    for (int j = 0; j <= total; ++j)
-      sum += coefficients[k++] * std::pow(u, total - j) * std::pow(v, j);
+    for (int j = 0; j <= total; ++j) sum += coefficients[k++] * pu[total - j] * pv[j];
   return sum;
 }
 
 void loadTrackSurfaces(const std::string& path, TrackSurface* points, TrackSurface* lines) {
   YamlReader yaml(path);
   const int degree = yaml.getInt("degree");
-  if (degree < 0 || degree > 8) throw Error(yaml.where("degree") + " must be in 0..8");
+  if (degree < 0 || degree > TrackSurface::kMaxDegree)
+    throw Error(yaml.where("degree") + " must be in 0.." +
+                std::to_string(TrackSurface::kMaxDegree));
   const std::size_t n = static_cast<std::size_t>((degree + 1) * (degree + 2) / 2);
   for (const char* key : {"width", "height"})
     if (yaml.has(key) && yaml.getDouble(key) <= 0)

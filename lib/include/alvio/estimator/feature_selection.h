@@ -19,7 +19,8 @@ class YamlReader;
 /// (u, v) = (x / width - 0.5, y / height - 0.5), monomials u^i v^j with i + j <= degree in
 /// order of total degree, then increasing j (as scripts/analyze_sensitivity.py writes it).
 struct TrackSurface {
-  int degree = 0;
+  static constexpr int kMaxDegree = 8;
+  int degree = 0;  ///< 0..kMaxDegree
   double width = 752, height = 480;
   std::vector<double> coefficients;
   double min_expected_track = 0;  ///< the selection level
