@@ -47,11 +47,10 @@ int main(int argc, char** argv) {
           readTrajectory(args.get("against"), parseTrajectoryFormat(args.get("est-format")), order);
       shared = sharedError(result, evaluateTrajectory(other, gt, options), options.max_dt);
     }
-    if (args.isSet("json")) {
-      std::string json = evaluationToJson(result, options, args.get("gt"), args.get("est"));
-      if (shared) json = addSharedErrorToJson(json, *shared, args.get("against"));
-      writeFileAtomically(args.get("json"), json);
-    }
+    if (args.isSet("json"))
+      writeFileAtomically(args.get("json"),
+                          evaluationToJson(result, options, args.get("gt"), args.get("est"),
+                                           shared ? &*shared : nullptr, args.get("against")));
     if (args.isSet("plot")) {
       namespace fs = std::filesystem;
       const fs::path dir = args.get("plot");

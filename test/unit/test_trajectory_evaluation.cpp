@@ -278,16 +278,12 @@ TEST(SharedError, SplitsTwoRunsErrorsIntoWhatTheyShareAndWhatDiffers) {
     const double s = 0.05 * i;
     return Eigen::Vector3d(0.02 * std::cos(1.7 * s), 0.01 * std::sin(2.3 * s), 0.0);
   };
-  const Trajectory a = withError(gt, [&](std::size_t i) {
-    Eigen::Vector3d e = common(i) + own(i);
-    return e;
-  });
+  const Trajectory a =
+      withError(gt, [&](std::size_t i) -> Eigen::Vector3d { return common(i) + own(i); });
   // The second run lacks every third pose and stamps 1 ms late: pairing by index would fail.
   Trajectory b;
-  const Trajectory b_all = withError(gt, [&](std::size_t i) {
-    Eigen::Vector3d e = common(i) - own(i);
-    return e;
-  });
+  const Trajectory b_all =
+      withError(gt, [&](std::size_t i) -> Eigen::Vector3d { return common(i) - own(i); });
   for (std::size_t i = 0; i < b_all.size(); ++i)
     if (i % 3 != 2) {
       b.push_back(b_all[i]);
@@ -320,10 +316,7 @@ TEST(SharedError, SplitsTwoRunsErrorsIntoWhatTheyShareAndWhatDiffers) {
 
   // Opposite errors share nothing; the same error is all shared.
   const Trajectory plus = withError(gt, own);
-  const Trajectory minus = withError(gt, [&](std::size_t i) {
-    Eigen::Vector3d e = -own(i);
-    return e;
-  });
+  const Trajectory minus = withError(gt, [&](std::size_t i) -> Eigen::Vector3d { return -own(i); });
   const SharedError opposite =
       sharedError(evaluateTrajectory(plus, gt, o), evaluateTrajectory(minus, gt, o), 0.01);
   EXPECT_NEAR(opposite.shared_fraction, 0.0, 1e-12);
@@ -349,6 +342,5 @@ TEST(SharedError, EachRunIsAlignedOnItsOwnAndTooFewCommonTimesIsAnError) {
 
   Trajectory late = gt;
   for (auto& p : late) p.t += 1000;
-  Trajectory late_gt = late;
-  EXPECT_THROW(sharedError(ra, evaluateTrajectory(late, late_gt, o), 0.01), Error);
+  EXPECT_THROW(sharedError(ra, evaluateTrajectory(late, late, o), 0.01), Error);
 }

@@ -46,7 +46,8 @@ std::string formatEvaluationText(const EvaluationResult& r, const EvaluationOpti
 }
 
 std::string evaluationToJson(const EvaluationResult& r, const EvaluationOptions& o,
-                             const std::string& gt_path, const std::string& est_path) {
+                             const std::string& gt_path, const std::string& est_path,
+                             const SharedError* shared, const std::string& against_path) {
   nlohmann::json j;
   j["ground_truth"] = gt_path;
   j["estimate"] = est_path;
@@ -69,6 +70,17 @@ std::string evaluationToJson(const EvaluationResult& r, const EvaluationOptions&
                    {"translation_percent", statsJson(s.translation_percent)},
                    {"rotation_deg_per_m", statsJson(s.rotation_deg_per_m)}});
   j["rpe"] = rpe;
+  if (shared)
+    j["shared_error"] = {{"against", against_path},
+                         {"matched", shared->matched},
+                         {"rms_m", shared->rms_a},
+                         {"against_rms_m", shared->rms_b},
+                         {"difference_rms_m", shared->rms_difference},
+                         {"shared_rms_m", shared->rms_shared},
+                         {"shared_fraction", shared->shared_fraction},
+                         {"axis_correlation",
+                          {shared->axis_correlation.x(), shared->axis_correlation.y(),
+                           shared->axis_correlation.z()}}};
   return j.dump(2) + "\n";
 }
 
@@ -92,25 +104,10 @@ std::string formatSharedErrorText(const SharedError& s, const std::string& again
                 "  ATE [m]: this run %.4f, the other %.4f; their errors differ by %.4f (rms)\n"
                 "  shared error %.4f m rms, %.1f %% of the two runs' squared error; "
                 "correlation along x / y / z %.2f / %.2f / %.2f\n",
-                against_path.c_str(), s.matched, s.rms_a, s.rms_b, s.rms_difference,
-                s.rms_shared, 100 * s.shared_fraction, s.axis_correlation.x(),
-                s.axis_correlation.y(), s.axis_correlation.z());
+                against_path.c_str(), s.matched, s.rms_a, s.rms_b, s.rms_difference, s.rms_shared,
+                100 * s.shared_fraction, s.axis_correlation.x(), s.axis_correlation.y(),
+                s.axis_correlation.z());
   return buf;
-}
-
-std::string addSharedErrorToJson(const std::string& json, const SharedError& s,
-                                 const std::string& against_path) {
-  nlohmann::json j = nlohmann::json::parse(json);
-  j["shared_error"] = {{"against", against_path},
-                       {"matched", s.matched},
-                       {"rms_m", s.rms_a},
-                       {"against_rms_m", s.rms_b},
-                       {"difference_rms_m", s.rms_difference},
-                       {"shared_rms_m", s.rms_shared},
-                       {"shared_fraction", s.shared_fraction},
-                       {"axis_correlation",
-                        {s.axis_correlation.x(), s.axis_correlation.y(), s.axis_correlation.z()}}};
-  return j.dump(2) + "\n";
 }
 
 }  // namespace alvio
