@@ -7,6 +7,7 @@
 #include <unordered_map>
 
 #include "alvio/common/error.h"
+#include "alvio/frontend/pyramidal_klt.h"
 #include "alvio/frontend/rotated_pixels.h"
 
 namespace alvio {
@@ -69,8 +70,7 @@ void PointTracker::flow(const std::vector<cv::Mat>& from_pyramid,
   const cv::TermCriteria stop(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 30, 0.01);
   // No error output (cv::noArray()): KLT's residual per point goes unused, and computing it
   // costs about a tenth of the tracking.
-  cv::calcOpticalFlowPyrLK(from_pyramid, to_pyramid, from, *to, *status, cv::noArray(), win, levels,
-                           stop, to->empty() ? 0 : cv::OPTFLOW_USE_INITIAL_FLOW);
+  trackPyramidalKlt(from_pyramid, to_pyramid, from, to, status, win, levels, stop, !to->empty());
 }
 
 std::vector<uchar> PointTracker::returns(const std::vector<cv::Mat>& prev_pyramid,

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <opencv2/video/tracking.hpp>
 
+#include "alvio/frontend/pyramidal_klt.h"
 #include "alvio/frontend/rotated_pixels.h"
 
 namespace alvio {
@@ -154,8 +155,8 @@ void OpticalFlowLineTracker::predict(const std::vector<cv::Mat>& pyramid, cv::Si
   std::vector<cv::Point2f> moved;
   std::vector<uchar> status;
   // Without KLT's error output, which nothing reads: about a tenth of the KLT time.
-  cv::calcOpticalFlowPyrLK(prev_pyramid_, pyramid, samples, moved, status, cv::noArray(),
-                           kltWindow(), options_.flow.klt_pyramid_levels, kltStop());
+  trackPyramidalKlt(prev_pyramid_, pyramid, samples, &moved, &status, kltWindow(),
+                    options_.flow.klt_pyramid_levels, kltStop(), false);
   for (std::size_t i = 0; i < moved.size(); ++i)
     status[i] = status[i] && !windowOutside(moved[i], image_size);
   for (std::size_t i = 0; i < tracks_.size(); ++i)
@@ -182,8 +183,8 @@ void OpticalFlowLineTracker::predictFromRotation(const std::vector<cv::Mat>& pyr
       });
   std::vector<cv::Point2f> moved = predicted;
   std::vector<uchar> status;
-  cv::calcOpticalFlowPyrLK(prev_pyramid_, pyramid, samples, moved, status, cv::noArray(),
-                           kltWindow(), f.gyro_klt_levels, kltStop(), cv::OPTFLOW_USE_INITIAL_FLOW);
+  trackPyramidalKlt(prev_pyramid_, pyramid, samples, &moved, &status, kltWindow(),
+                    f.gyro_klt_levels, kltStop(), true);
   for (std::size_t i = 0; i < moved.size(); ++i)
     status[i] = status[i] && !windowOutside(moved[i], image_size);
   // A line the few levels lost, or lost a sample of, tries again on all levels.
@@ -203,8 +204,8 @@ void OpticalFlowLineTracker::predictFromRotation(const std::vector<cv::Mat>& pyr
       to.push_back(predicted[t * n + k]);
     }
   std::vector<uchar> again;
-  cv::calcOpticalFlowPyrLK(prev_pyramid_, pyramid, from, to, again, cv::noArray(), kltWindow(),
-                           f.klt_pyramid_levels, kltStop(), cv::OPTFLOW_USE_INITIAL_FLOW);
+  trackPyramidalKlt(prev_pyramid_, pyramid, from, &to, &again, kltWindow(), f.klt_pyramid_levels,
+                    kltStop(), true);
   for (std::size_t j = 0; j < again_lines.size(); ++j) {
     const std::size_t t = again_lines[j];
     for (std::size_t k = 0; k < n; ++k) {

@@ -1,0 +1,401 @@
+#include "alvio/frontend/pyramidal_klt.h"
+
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
+#include <cstdint>
+#include <opencv2/video/tracking.hpp>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+namespace alvio {
+namespace {
+
+void openCvKlt(const std::vector<cv::Mat>& from_pyramid, const std::vector<cv::Mat>& to_pyramid,
+               const std::vector<cv::Point2f>& from, std::vector<cv::Point2f>* to,
+               std::vector<uchar>* status, cv::Size window, int max_level,
+               const cv::TermCriteria& stop, bool use_initial_flow) {
+  cv::calcOpticalFlowPyrLK(from_pyramid, to_pyramid, from, *to, *status, cv::noArray(), window,
+                           max_level, stop, use_initial_flow ? cv::OPTFLOW_USE_INITIAL_FLOW : 0);
+}
+
+#if defined(__SSE2__)
+
+// OpenCV's fixed point: bilinear weights in 14 bits; image values keep 5 more bits.
+constexpr int kWeightBits = 14;
+constexpr float kSumScale = 1.f / (1 << 20);
+constexpr float kMinEigenThreshold = 1e-4f;
+
+// A pyramid's levels and the step between its images (2 when each has its gradients after it).
+struct PyramidLayout {
+  int levels = -1;
+  int step = 1;
+};
+
+PyramidLayout layoutOf(const std::vector<cv::Mat>& pyramid) {
+  PyramidLayout layout;
+  layout.levels = static_cast<int>(pyramid.size()) - 1;
+  if (layout.levels % 2 == 1 && pyramid[0].channels() * 2 == pyramid[1].channels() &&
+      pyramid[1].depth() == CV_16S) {
+    layout.step = 2;
+    layout.levels /= 2;
+  }
+  return layout;
+}
+
+// The border every level above the first needs around it (the window), as OpenCV checks.
+bool padded(const std::vector<cv::Mat>& pyramid, const PyramidLayout& layout, cv::Size window) {
+  if (layout.levels <= 0) return true;
+  cv::Size full;
+  cv::Point offset;
+  const cv::Mat& level1 = pyramid[layout.step];
+  level1.locateROI(full, offset);
+  return offset.x >= window.width && offset.y >= window.height &&
+         offset.x + level1.cols + window.width <= full.width &&
+         offset.y + level1.rows + window.height <= full.height;
+}
+
+struct Bilinear {
+  int w00, w01, w10, w11;
+  __m128i top, bottom;  // (w00, w01) and (w10, w11) as 16-bit pairs, for _mm_madd_epi16
+};
+
+inline int pairOf(int left, int right) {
+  return static_cast<int>(static_cast<uint32_t>(static_cast<uint16_t>(left)) |
+                          (static_cast<uint32_t>(static_cast<uint16_t>(right)) << 16));
+}
+
+inline Bilinear bilinear(float a, float b) {
+  Bilinear w;
+  w.w00 = cvRound((1.f - a) * (1.f - b) * (1 << kWeightBits));
+  w.w01 = cvRound(a * (1.f - b) * (1 << kWeightBits));
+  w.w10 = cvRound((1.f - a) * b * (1 << kWeightBits));
+  w.w11 = (1 << kWeightBits) - w.w00 - w.w01 - w.w10;
+  w.top = _mm_set1_epi32(pairOf(w.w00, w.w01));
+  w.bottom = _mm_set1_epi32(pairOf(w.w10, w.w11));
+  return w;
+}
+
+// Pixels p[0..7] of an 8-bit image, interpolated between p[x], p[x + 1] and the row below;
+// in 1/32 grey levels, as int16.
+inline __m128i interpolate8(const uchar* p, std::ptrdiff_t step, const Bilinear& w) {
+  const __m128i zero = _mm_setzero_si128();
+  const __m128i v00 = _mm_unpacklo_epi8(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p)), zero);
+  const __m128i v01 =
+      _mm_unpacklo_epi8(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p + 1)), zero);
+  const __m128i v10 =
+      _mm_unpacklo_epi8(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p + step)), zero);
+  const __m128i v11 =
+      _mm_unpacklo_epi8(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p + step + 1)), zero);
+  const __m128i round = _mm_set1_epi32(1 << (kWeightBits - 5 - 1));
+  __m128i lo =
+      _mm_add_epi32(_mm_add_epi32(_mm_madd_epi16(_mm_unpacklo_epi16(v00, v01), w.top), round),
+                    _mm_madd_epi16(_mm_unpacklo_epi16(v10, v11), w.bottom));
+  __m128i hi =
+      _mm_add_epi32(_mm_add_epi32(_mm_madd_epi16(_mm_unpackhi_epi16(v00, v01), w.top), round),
+                    _mm_madd_epi16(_mm_unpackhi_epi16(v10, v11), w.bottom));
+  return _mm_packs_epi32(_mm_srai_epi32(lo, kWeightBits - 5), _mm_srai_epi32(hi, kWeightBits - 5));
+}
+
+// Four pixels' gradients (x, y interleaved int16 at d[0..7]), interpolated like interpolate8:
+// Ix0 Iy0 Ix1 Iy1 Ix2 Iy2 Ix3 Iy3.
+inline __m128i interpolateGradients4(const short* d, std::ptrdiff_t step, const Bilinear& w) {
+  const __m128i v00 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(d));
+  const __m128i v01 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(d + 2));
+  const __m128i v10 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(d + step));
+  const __m128i v11 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(d + step + 2));
+  const __m128i round = _mm_set1_epi32(1 << (kWeightBits - 1));
+  __m128i lo =
+      _mm_add_epi32(_mm_add_epi32(_mm_madd_epi16(_mm_unpacklo_epi16(v00, v01), w.top), round),
+                    _mm_madd_epi16(_mm_unpacklo_epi16(v10, v11), w.bottom));
+  __m128i hi =
+      _mm_add_epi32(_mm_add_epi32(_mm_madd_epi16(_mm_unpackhi_epi16(v00, v01), w.top), round),
+                    _mm_madd_epi16(_mm_unpackhi_epi16(v10, v11), w.bottom));
+  return _mm_packs_epi32(_mm_srai_epi32(lo, kWeightBits), _mm_srai_epi32(hi, kWeightBits));
+}
+
+// OpenCV's v_reduce_sum: (l0 + l2) + (l1 + l3).
+inline float reduceSum(__m128 v) {
+  v = _mm_add_ps(v, _mm_castsi128_ps(_mm_srli_si128(_mm_castps_si128(v), 8)));
+  v = _mm_add_ps(v, _mm_castsi128_ps(_mm_srli_si128(_mm_castps_si128(v), 4)));
+  return _mm_cvtss_f32(v);
+}
+
+// One pyramid level for a range of points: OpenCV's LKTrackerInvoker, same arithmetic.
+class LevelTracker {
+ public:
+  LevelTracker(const cv::Mat& I, const cv::Mat& dI, const cv::Mat& J, cv::Size window, int level,
+               int max_level, int max_iterations, double epsilon_squared, bool use_initial_flow,
+               const cv::Point2f* from, cv::Point2f* to, uchar* status)
+      : I_(I),
+        dI_(dI),
+        J_(J),
+        width_(window.width),
+        height_(window.height),
+        simd_(8 * (window.width / 8)),
+        tail_(window.width - 8 * (window.width / 8)),
+        level_(level),
+        max_level_(max_level),
+        max_iterations_(max_iterations),
+        epsilon_squared_(epsilon_squared),
+        use_initial_flow_(use_initial_flow),
+        from_(from),
+        to_(to),
+        status_(status) {}
+
+  void operator()(const cv::Range& range) const {
+    Buffers buffers(width_, height_, simd_, tail_);
+    for (int i = range.start; i < range.end; ++i) trackPoint(i, &buffers);
+  }
+
+ private:
+  // The first image's window: values, gradients in OpenCV's pairing for its 8-pixel blocks,
+  // and the gradients of each row's remaining pixels as floats.
+  struct Buffers {
+    Buffers(int width, int height, int simd, int tail)
+        : values(static_cast<std::size_t>(width) * height),
+          paired(static_cast<std::size_t>(height) * 2 * simd),
+          tail_x(static_cast<std::size_t>(height) * 8),
+          tail_y(static_cast<std::size_t>(height) * 8),
+          products(static_cast<std::size_t>(height) * 24) {}
+    std::vector<short> values;
+    std::vector<short> paired;
+    // Per row, the last 8 pixels' gradients as floats (the tail is their last tail_ lanes),
+    // and up to three products per lane, summed one by one afterwards.
+    std::vector<float> tail_x, tail_y, products;
+  };
+
+  void trackPoint(int i, Buffers* buf) const {
+    const cv::Point2f half((width_ - 1) * 0.5f, (height_ - 1) * 0.5f);
+    cv::Point2f prev = from_[i] * static_cast<float>(1. / (1 << level_));
+    cv::Point2f next;
+    if (level_ == max_level_)
+      next = use_initial_flow_ ? to_[i] * static_cast<float>(1. / (1 << level_)) : prev;
+    else
+      next = to_[i] * 2.f;
+    to_[i] = next;
+
+    prev -= half;
+    const cv::Point iprev(cvFloor(prev.x), cvFloor(prev.y));
+    if (iprev.x < -width_ || iprev.x >= dI_.cols || iprev.y < -height_ || iprev.y >= dI_.rows) {
+      if (level_ == 0) status_[i] = false;
+      return;
+    }
+    float A11, A12, A22;
+    takeTemplate(iprev, bilinear(prev.x - iprev.x, prev.y - iprev.y), buf, &A11, &A12, &A22);
+
+    float D = A11 * A22 - A12 * A12;
+    const float min_eigen = (A22 + A11 - std::sqrt((A11 - A22) * (A11 - A22) + 4.f * A12 * A12)) /
+                            (2 * width_ * height_);
+    if (min_eigen < kMinEigenThreshold || D < FLT_EPSILON) {
+      if (level_ == 0) status_[i] = false;
+      return;
+    }
+    D = 1.f / D;
+
+    next -= half;
+    cv::Point2f prev_delta;
+    for (int j = 0; j < max_iterations_; ++j) {
+      const cv::Point inext(cvFloor(next.x), cvFloor(next.y));
+      if (inext.x < -width_ || inext.x >= J_.cols || inext.y < -height_ || inext.y >= J_.rows) {
+        if (level_ == 0) status_[i] = false;
+        break;
+      }
+      float b1, b2;
+      mismatch(inext, bilinear(next.x - inext.x, next.y - inext.y), buf, &b1, &b2);
+      const cv::Point2f delta(static_cast<float>((A12 * b2 - A22 * b1) * D),
+                              static_cast<float>((A12 * b1 - A11 * b2) * D));
+      next += delta;
+      to_[i] = next + half;
+      if (delta.ddot(delta) <= epsilon_squared_) break;
+      if (j > 0 && std::abs(delta.x + prev_delta.x) < 0.01 &&
+          std::abs(delta.y + prev_delta.y) < 0.01) {
+        to_[i] -= delta * 0.5f;
+        break;
+      }
+      prev_delta = delta;
+    }
+  }
+
+  // The window around `at` in the first image, and its gradients' products summed as OpenCV
+  // sums them: pixels 0..simd_-1 of each row in four float lanes, the rest one by one.
+  void takeTemplate(cv::Point at, const Bilinear& w, Buffers* buf, float* A11, float* A12,
+                    float* A22) const {
+    const std::ptrdiff_t step_i = static_cast<std::ptrdiff_t>(I_.step / I_.elemSize1());
+    const std::ptrdiff_t step_d = static_cast<std::ptrdiff_t>(dI_.step / dI_.elemSize1());
+    __m128 qA11 = _mm_setzero_ps(), qA12 = _mm_setzero_ps(), qA22 = _mm_setzero_ps();
+    const auto accumulate = [&](__m128i g) {
+      const __m128 fx = _mm_cvtepi32_ps(_mm_srai_epi32(_mm_slli_epi32(g, 16), 16));
+      const __m128 fy = _mm_cvtepi32_ps(_mm_srai_epi32(g, 16));
+      qA22 = _mm_add_ps(_mm_mul_ps(fy, fy), qA22);
+      qA12 = _mm_add_ps(_mm_mul_ps(fx, fy), qA12);
+      qA11 = _mm_add_ps(_mm_mul_ps(fx, fx), qA11);
+    };
+    for (int y = 0; y < height_; ++y) {
+      const uchar* src = I_.ptr() + (y + at.y) * step_i + at.x;
+      const short* dsrc = dI_.ptr<short>() + (y + at.y) * step_d + at.x * 2;
+      short* values = buf->values.data() + static_cast<std::ptrdiff_t>(y) * width_;
+      short* paired = buf->paired.data() + static_cast<std::ptrdiff_t>(y) * 2 * simd_;
+      for (int x = 0; x < simd_; x += 8) {
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(values + x), interpolate8(src + x, step_i, w));
+        const __m128i g0 = interpolateGradients4(dsrc + 2 * x, step_d, w);
+        const __m128i g1 = interpolateGradients4(dsrc + 2 * x + 8, step_d, w);
+        accumulate(g0);
+        accumulate(g1);
+        // Ix0 Ix4 Iy0 Iy4 Ix1 Ix5 Iy1 Iy5 | Ix2 Ix6 Iy2 Iy6 Ix3 Ix7 Iy3 Iy7, as OpenCV pairs
+        // them with the differences.
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(paired + 2 * x), _mm_unpacklo_epi16(g0, g1));
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(paired + 2 * x + 8),
+                         _mm_unpackhi_epi16(g0, g1));
+      }
+      if (tail_ > 0) {
+        // The last 8 pixels (overlapping the blocks), of which the last tail_ are new.
+        const int x = width_ - 8;
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(values + x), interpolate8(src + x, step_i, w));
+        float* tx = buf->tail_x.data() + 8 * y;
+        float* ty = buf->tail_y.data() + 8 * y;
+        float* p = buf->products.data() + 24 * y;
+        for (int half = 0; half < 2; ++half) {
+          const __m128i g = interpolateGradients4(dsrc + 2 * x + 8 * half, step_d, w);
+          const __m128 fx = _mm_cvtepi32_ps(_mm_srai_epi32(_mm_slli_epi32(g, 16), 16));
+          const __m128 fy = _mm_cvtepi32_ps(_mm_srai_epi32(g, 16));
+          _mm_storeu_ps(tx + 4 * half, fx);
+          _mm_storeu_ps(ty + 4 * half, fy);
+          _mm_storeu_ps(p + 4 * half, _mm_mul_ps(fx, fx));
+          _mm_storeu_ps(p + 8 + 4 * half, _mm_mul_ps(fx, fy));
+          _mm_storeu_ps(p + 16 + 4 * half, _mm_mul_ps(fy, fy));
+        }
+      }
+    }
+    // OpenCV adds the rows' remaining pixels one by one, in row order, then the lanes.
+    float a11 = 0, a12 = 0, a22 = 0;
+    const int first = 8 - tail_;  // the tail's first lane in each row's last 8 pixels
+    for (int y = 0; y < height_ && tail_ > 0; ++y) {
+      const float* p = buf->products.data() + 24 * y + first;
+      for (int k = 0; k < tail_; ++k) {
+        a11 += p[k];
+        a12 += p[8 + k];
+        a22 += p[16 + k];
+      }
+    }
+    a11 += reduceSum(qA11);
+    a12 += reduceSum(qA12);
+    a22 += reduceSum(qA22);
+    *A11 = a11 * kSumScale;
+    *A12 = a12 * kSumScale;
+    *A22 = a22 * kSumScale;
+  }
+
+  // The window around `at` in the second image against the template: the sums of the
+  // differences times the gradients, in OpenCV's order.
+  void mismatch(cv::Point at, const Bilinear& w, Buffers* buf, float* b1, float* b2) const {
+    const std::ptrdiff_t step_j = static_cast<std::ptrdiff_t>(J_.step / J_.elemSize1());
+    __m128 qb0 = _mm_setzero_ps(), qb1 = _mm_setzero_ps();
+    float* products = buf->products.data();
+    for (int y = 0; y < height_; ++y) {
+      const uchar* src = J_.ptr() + (y + at.y) * step_j + at.x;
+      const short* values = buf->values.data() + static_cast<std::ptrdiff_t>(y) * width_;
+      const short* paired = buf->paired.data() + static_cast<std::ptrdiff_t>(y) * 2 * simd_;
+      for (int x = 0; x < simd_; x += 8) {
+        const __m128i diff =
+            _mm_sub_epi16(interpolate8(src + x, step_j, w),
+                          _mm_loadu_si128(reinterpret_cast<const __m128i*>(values + x)));
+        const __m128i d03 = _mm_unpacklo_epi16(diff, diff);  // d0 d0 d1 d1 d2 d2 d3 d3
+        const __m128i d47 = _mm_unpackhi_epi16(diff, diff);
+        const __m128i g0 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(paired + 2 * x));
+        const __m128i g1 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(paired + 2 * x + 8));
+        qb0 = _mm_add_ps(qb0, _mm_cvtepi32_ps(_mm_madd_epi16(_mm_unpacklo_epi16(d03, d47), g0)));
+        qb1 = _mm_add_ps(qb1, _mm_cvtepi32_ps(_mm_madd_epi16(_mm_unpackhi_epi16(d03, d47), g1)));
+      }
+      if (tail_ > 0) {
+        const int x = width_ - 8;
+        const __m128i diff =
+            _mm_sub_epi16(interpolate8(src + x, step_j, w),
+                          _mm_loadu_si128(reinterpret_cast<const __m128i*>(values + x)));
+        const __m128 d03 = _mm_cvtepi32_ps(_mm_srai_epi32(_mm_unpacklo_epi16(diff, diff), 16));
+        const __m128 d47 = _mm_cvtepi32_ps(_mm_srai_epi32(_mm_unpackhi_epi16(diff, diff), 16));
+        const float* tx = buf->tail_x.data() + 8 * y;
+        const float* ty = buf->tail_y.data() + 8 * y;
+        float* p = products + 16 * y;
+        _mm_storeu_ps(p, _mm_mul_ps(d03, _mm_loadu_ps(tx)));
+        _mm_storeu_ps(p + 4, _mm_mul_ps(d47, _mm_loadu_ps(tx + 4)));
+        _mm_storeu_ps(p + 8, _mm_mul_ps(d03, _mm_loadu_ps(ty)));
+        _mm_storeu_ps(p + 12, _mm_mul_ps(d47, _mm_loadu_ps(ty + 4)));
+      }
+    }
+    float ib1 = 0, ib2 = 0;
+    const int first = 8 - tail_;  // the tail's first lane in each row's last 8 pixels
+    for (int y = 0; y < height_ && tail_ > 0; ++y) {
+      const float* p = products + 16 * y + first;
+      for (int k = 0; k < tail_; ++k) {
+        ib1 += p[k];
+        ib2 += p[8 + k];
+      }
+    }
+    // OpenCV's lane order: (qb0 + qb1) interleaved by pairs, then each half reduced.
+    const __m128i qb =
+        _mm_shuffle_epi32(_mm_castps_si128(_mm_add_ps(qb0, qb1)), _MM_SHUFFLE(3, 1, 2, 0));
+    ib1 += reduceSum(_mm_castsi128_ps(_mm_unpacklo_epi64(qb, _mm_setzero_si128())));
+    ib2 += reduceSum(_mm_castsi128_ps(_mm_unpackhi_epi64(qb, _mm_setzero_si128())));
+    *b1 = ib1 * kSumScale;
+    *b2 = ib2 * kSumScale;
+  }
+
+  const cv::Mat& I_;
+  const cv::Mat& dI_;
+  const cv::Mat& J_;
+  int width_, height_, simd_, tail_;
+  int level_, max_level_, max_iterations_;
+  double epsilon_squared_;
+  bool use_initial_flow_;
+  const cv::Point2f* from_;
+  cv::Point2f* to_;
+  uchar* status_;
+};
+
+#endif  // __SSE2__
+
+}  // namespace
+
+void trackPyramidalKlt(const std::vector<cv::Mat>& from_pyramid,
+                       const std::vector<cv::Mat>& to_pyramid, const std::vector<cv::Point2f>& from,
+                       std::vector<cv::Point2f>* to, std::vector<uchar>* status, cv::Size window,
+                       int max_level, const cv::TermCriteria& stop, bool use_initial_flow) {
+#if defined(__SSE2__)
+  const bool supported = !from_pyramid.empty() && !to_pyramid.empty() && max_level >= 0 &&
+                         window.width >= 8 && window.height > 2 &&
+                         from_pyramid[0].type() == CV_8UC1 && to_pyramid[0].type() == CV_8UC1;
+  const PyramidLayout from_layout = supported ? layoutOf(from_pyramid) : PyramidLayout();
+  const PyramidLayout to_layout = supported ? layoutOf(to_pyramid) : PyramidLayout();
+  if (!supported || from_layout.step != 2 || !padded(from_pyramid, from_layout, window) ||
+      !padded(to_pyramid, to_layout, window) || (use_initial_flow && to->size() != from.size()))
+    return openCvKlt(from_pyramid, to_pyramid, from, to, status, window, max_level, stop,
+                     use_initial_flow);
+  if (from.empty()) {
+    to->clear();
+    status->clear();
+    return;
+  }
+  if (!use_initial_flow) to->resize(from.size());
+  status->assign(from.size(), 1);
+  max_level = std::min({max_level, from_layout.levels, to_layout.levels});
+  const int max_iterations =
+      (stop.type & cv::TermCriteria::COUNT) ? std::min(std::max(stop.maxCount, 0), 100) : 30;
+  double epsilon =
+      (stop.type & cv::TermCriteria::EPS) ? std::min(std::max(stop.epsilon, 0.), 10.) : 0.01;
+  epsilon *= epsilon;
+  for (int level = max_level; level >= 0; --level) {
+    const LevelTracker tracker(from_pyramid[level * 2], from_pyramid[level * 2 + 1],
+                               to_pyramid[level * to_layout.step], window, level, max_level,
+                               max_iterations, epsilon, use_initial_flow, from.data(), to->data(),
+                               status->data());
+    cv::parallel_for_(cv::Range(0, static_cast<int>(from.size())), tracker);
+  }
+#else
+  openCvKlt(from_pyramid, to_pyramid, from, to, status, window, max_level, stop, use_initial_flow);
+#endif
+}
+
+}  // namespace alvio
