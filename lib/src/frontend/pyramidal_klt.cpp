@@ -146,7 +146,7 @@ class LevelTracker {
         status_(status) {}
 
   void operator()(const cv::Range& range) const {
-    Buffers buffers(width_, height_, simd_, tail_);
+    Buffers buffers(width_, height_, simd_);
     for (int i = range.start; i < range.end; ++i) trackPoint(i, &buffers);
   }
 
@@ -154,17 +154,15 @@ class LevelTracker {
   // The first image's window: values, gradients in OpenCV's pairing for its 8-pixel blocks,
   // and the gradients of each row's remaining pixels as floats.
   struct Buffers {
-    Buffers(int width, int height, int simd, int tail)
+    Buffers(int width, int height, int simd)
         : values(static_cast<std::size_t>(width) * height),
           paired(static_cast<std::size_t>(height) * 2 * simd),
           tail_x(static_cast<std::size_t>(height) * 8),
-          tail_y(static_cast<std::size_t>(height) * 8),
-          products(static_cast<std::size_t>(height) * 24) {}
+          tail_y(static_cast<std::size_t>(height) * 8) {}
     std::vector<short> values;
     std::vector<short> paired;
-    // Per row, the last 8 pixels' gradients as floats (the tail is their last tail_ lanes),
-    // and up to three products per lane, summed one by one afterwards.
-    std::vector<float> tail_x, tail_y, products;
+    // Per row, the last 8 pixels' gradients as floats (the tail is their last tail_ lanes).
+    std::vector<float> tail_x, tail_y;
   };
 
   void trackPoint(int i, Buffers* buf) const {
@@ -233,6 +231,11 @@ class LevelTracker {
       qA12 = _mm_add_ps(_mm_mul_ps(fx, fy), qA12);
       qA11 = _mm_add_ps(_mm_mul_ps(fx, fx), qA11);
     };
+    // OpenCV adds each row's remaining pixels one by one (then the lanes); added as each row
+    // ends, the chains overlap the next rows' work.
+    float a11 = 0, a12 = 0, a22 = 0;
+    const int first = 8 - tail_;  // the tail's first lane in each row's last 8 pixels
+    alignas(16) float p[24];
     for (int y = 0; y < height_; ++y) {
       const uchar* src = I_.ptr() + (y + at.y) * step_i + at.x;
       const short* dsrc = dI_.ptr<short>() + (y + at.y) * step_d + at.x * 2;
@@ -256,28 +259,21 @@ class LevelTracker {
         _mm_storeu_si128(reinterpret_cast<__m128i*>(values + x), interpolate8(src + x, step_i, w));
         float* tx = buf->tail_x.data() + 8 * y;
         float* ty = buf->tail_y.data() + 8 * y;
-        float* p = buf->products.data() + 24 * y;
         for (int half = 0; half < 2; ++half) {
           const __m128i g = interpolateGradients4(dsrc + 2 * x + 8 * half, step_d, w);
           const __m128 fx = _mm_cvtepi32_ps(_mm_srai_epi32(_mm_slli_epi32(g, 16), 16));
           const __m128 fy = _mm_cvtepi32_ps(_mm_srai_epi32(g, 16));
           _mm_storeu_ps(tx + 4 * half, fx);
           _mm_storeu_ps(ty + 4 * half, fy);
-          _mm_storeu_ps(p + 4 * half, _mm_mul_ps(fx, fx));
-          _mm_storeu_ps(p + 8 + 4 * half, _mm_mul_ps(fx, fy));
-          _mm_storeu_ps(p + 16 + 4 * half, _mm_mul_ps(fy, fy));
+          _mm_store_ps(p + 4 * half, _mm_mul_ps(fx, fx));
+          _mm_store_ps(p + 8 + 4 * half, _mm_mul_ps(fx, fy));
+          _mm_store_ps(p + 16 + 4 * half, _mm_mul_ps(fy, fy));
         }
-      }
-    }
-    // OpenCV adds the rows' remaining pixels one by one, in row order, then the lanes.
-    float a11 = 0, a12 = 0, a22 = 0;
-    const int first = 8 - tail_;  // the tail's first lane in each row's last 8 pixels
-    for (int y = 0; y < height_ && tail_ > 0; ++y) {
-      const float* p = buf->products.data() + 24 * y + first;
-      for (int k = 0; k < tail_; ++k) {
-        a11 += p[k];
-        a12 += p[8 + k];
-        a22 += p[16 + k];
+        for (int k = first; k < 8; ++k) {
+          a11 += p[k];
+          a12 += p[8 + k];
+          a22 += p[16 + k];
+        }
       }
     }
     a11 += reduceSum(qA11);
@@ -293,7 +289,11 @@ class LevelTracker {
   void mismatch(cv::Point at, const Bilinear& w, Buffers* buf, float* b1, float* b2) const {
     const std::ptrdiff_t step_j = static_cast<std::ptrdiff_t>(J_.step / J_.elemSize1());
     __m128 qb0 = _mm_setzero_ps(), qb1 = _mm_setzero_ps();
-    float* products = buf->products.data();
+    // OpenCV adds each row's remaining pixels one by one; added as each row ends, the chain
+    // overlaps the next rows' work.
+    float ib1 = 0, ib2 = 0;
+    const int first = 8 - tail_;  // the tail's first lane in each row's last 8 pixels
+    alignas(16) float p[16];
     for (int y = 0; y < height_; ++y) {
       const uchar* src = J_.ptr() + (y + at.y) * step_j + at.x;
       const short* values = buf->values.data() + static_cast<std::ptrdiff_t>(y) * width_;
@@ -318,20 +318,14 @@ class LevelTracker {
         const __m128 d47 = _mm_cvtepi32_ps(_mm_srai_epi32(_mm_unpackhi_epi16(diff, diff), 16));
         const float* tx = buf->tail_x.data() + 8 * y;
         const float* ty = buf->tail_y.data() + 8 * y;
-        float* p = products + 16 * y;
-        _mm_storeu_ps(p, _mm_mul_ps(d03, _mm_loadu_ps(tx)));
-        _mm_storeu_ps(p + 4, _mm_mul_ps(d47, _mm_loadu_ps(tx + 4)));
-        _mm_storeu_ps(p + 8, _mm_mul_ps(d03, _mm_loadu_ps(ty)));
-        _mm_storeu_ps(p + 12, _mm_mul_ps(d47, _mm_loadu_ps(ty + 4)));
-      }
-    }
-    float ib1 = 0, ib2 = 0;
-    const int first = 8 - tail_;  // the tail's first lane in each row's last 8 pixels
-    for (int y = 0; y < height_ && tail_ > 0; ++y) {
-      const float* p = products + 16 * y + first;
-      for (int k = 0; k < tail_; ++k) {
-        ib1 += p[k];
-        ib2 += p[8 + k];
+        _mm_store_ps(p, _mm_mul_ps(d03, _mm_loadu_ps(tx)));
+        _mm_store_ps(p + 4, _mm_mul_ps(d47, _mm_loadu_ps(tx + 4)));
+        _mm_store_ps(p + 8, _mm_mul_ps(d03, _mm_loadu_ps(ty)));
+        _mm_store_ps(p + 12, _mm_mul_ps(d47, _mm_loadu_ps(ty + 4)));
+        for (int k = first; k < 8; ++k) {
+          ib1 += p[k];
+          ib2 += p[8 + k];
+        }
       }
     }
     // OpenCV's lane order: (qb0 + qb1) interleaved by pairs, then each half reduced.
