@@ -15,6 +15,7 @@
 #include <iostream>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
 #include <optional>
 
 #include "alvio/camera/camera_model.h"
@@ -28,6 +29,7 @@
 #include "alvio/frontend/gyro_rotation.h"
 #include "alvio/frontend/min_eigen_response.h"
 #include "alvio/frontend/point_tracker.h"
+#include "alvio/frontend/pyramidal_klt.h"
 #include "alvio/geometry/line_projection_factor.h"
 #include "alvio/imu/imu_preintegration.h"
 #include "alvio/io/euroc_dataset.h"
@@ -173,6 +175,50 @@ void BM_PointTracking(benchmark::State& state) {
   state.counters["points"] = n;
 }
 BENCHMARK(BM_PointTracking)->Unit(benchmark::kMillisecond)->DenseRange(0, 3)->ArgName("anchors");
+
+// KLT alone on the frame pair's CLAHE images, 150 corners, all levels: OpenCV's
+// calcOpticalFlowPyrLK against alvio's trackPyramidalKlt (the same tracks bit for bit). Arg:
+// the window (21 the point tracker's, 15 the line tracker's).
+struct KltInput {
+  std::vector<cv::Mat> from, to;
+  std::vector<cv::Point2f> corners;
+};
+KltInput kltInput(int window) {
+  const FramePair& f = framePair();
+  const cv::Ptr<cv::CLAHE> clahe = cv::createCLAHE(3.0, cv::Size(8, 8));
+  cv::Mat a, b;
+  clahe->apply(f.a, a);
+  clahe->apply(f.b, b);
+  KltInput in;
+  cv::goodFeaturesToTrack(a, in.corners, 150, 0.01, 30);
+  const cv::Size win(window, window);
+  cv::buildOpticalFlowPyramid(a, in.from, win, 3, true, cv::BORDER_REFLECT_101, cv::BORDER_CONSTANT,
+                              false);
+  cv::buildOpticalFlowPyramid(b, in.to, win, 3, true, cv::BORDER_REFLECT_101, cv::BORDER_CONSTANT,
+                              false);
+  return in;
+}
+const cv::TermCriteria kKltStop(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 30, 0.01);
+void BM_KltOpenCv(benchmark::State& state) {
+  const int window = static_cast<int>(state.range(0));
+  const KltInput in = kltInput(window);
+  std::vector<cv::Point2f> tracked;
+  std::vector<uchar> status;
+  for (auto _ : state)
+    cv::calcOpticalFlowPyrLK(in.from, in.to, in.corners, tracked, status, cv::noArray(),
+                             cv::Size(window, window), 3, kKltStop);
+}
+BENCHMARK(BM_KltOpenCv)->Unit(benchmark::kMillisecond)->Arg(21)->Arg(15)->ArgName("window");
+void BM_KltAlvio(benchmark::State& state) {
+  const int window = static_cast<int>(state.range(0));
+  const KltInput in = kltInput(window);
+  std::vector<cv::Point2f> tracked;
+  std::vector<uchar> status;
+  for (auto _ : state)
+    trackPyramidalKlt(in.from, in.to, in.corners, &tracked, &status, cv::Size(window, window), 3,
+                      kKltStop, false);
+}
+BENCHMARK(BM_KltAlvio)->Unit(benchmark::kMillisecond)->Arg(21)->Arg(15)->ArgName("window");
 
 // New corners for a frame that still tracks 120: the point tracker's discs around those,
 // 30 wanted. OpenCV's goodFeaturesToTrack against alvio's CornerDetector (the same corners).
