@@ -78,42 +78,37 @@ inline Bilinear bilinear(float a, float b) {
   return w;
 }
 
+// Bilinear interpolation of eight 16-bit values: v00 a row, v01 its right neighbours, v10 and
+// v11 the same one row below; rounded and shifted right by kShift bits (OpenCV's CV_DESCALE).
+template <int kShift>
+inline __m128i interpolate(__m128i v00, __m128i v01, __m128i v10, __m128i v11, const Bilinear& w) {
+  const __m128i round = _mm_set1_epi32(1 << (kShift - 1));
+  const __m128i lo =
+      _mm_add_epi32(_mm_add_epi32(_mm_madd_epi16(_mm_unpacklo_epi16(v00, v01), w.top), round),
+                    _mm_madd_epi16(_mm_unpacklo_epi16(v10, v11), w.bottom));
+  const __m128i hi =
+      _mm_add_epi32(_mm_add_epi32(_mm_madd_epi16(_mm_unpackhi_epi16(v00, v01), w.top), round),
+                    _mm_madd_epi16(_mm_unpackhi_epi16(v10, v11), w.bottom));
+  return _mm_packs_epi32(_mm_srai_epi32(lo, kShift), _mm_srai_epi32(hi, kShift));
+}
+
 // Pixels p[0..7] of an 8-bit image, interpolated between p[x], p[x + 1] and the row below;
 // in 1/32 grey levels, as int16.
 inline __m128i interpolate8(const uchar* p, std::ptrdiff_t step, const Bilinear& w) {
-  const __m128i zero = _mm_setzero_si128();
-  const __m128i v00 = _mm_unpacklo_epi8(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p)), zero);
-  const __m128i v01 =
-      _mm_unpacklo_epi8(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p + 1)), zero);
-  const __m128i v10 =
-      _mm_unpacklo_epi8(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p + step)), zero);
-  const __m128i v11 =
-      _mm_unpacklo_epi8(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p + step + 1)), zero);
-  const __m128i round = _mm_set1_epi32(1 << (kWeightBits - 5 - 1));
-  __m128i lo =
-      _mm_add_epi32(_mm_add_epi32(_mm_madd_epi16(_mm_unpacklo_epi16(v00, v01), w.top), round),
-                    _mm_madd_epi16(_mm_unpacklo_epi16(v10, v11), w.bottom));
-  __m128i hi =
-      _mm_add_epi32(_mm_add_epi32(_mm_madd_epi16(_mm_unpackhi_epi16(v00, v01), w.top), round),
-                    _mm_madd_epi16(_mm_unpackhi_epi16(v10, v11), w.bottom));
-  return _mm_packs_epi32(_mm_srai_epi32(lo, kWeightBits - 5), _mm_srai_epi32(hi, kWeightBits - 5));
+  const auto load = [](const uchar* q) {
+    return _mm_unpacklo_epi8(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(q)),
+                             _mm_setzero_si128());
+  };
+  return interpolate<kWeightBits - 5>(load(p), load(p + 1), load(p + step), load(p + step + 1), w);
 }
 
 // Four pixels' gradients (x, y interleaved int16 at d[0..7]), interpolated like interpolate8:
 // Ix0 Iy0 Ix1 Iy1 Ix2 Iy2 Ix3 Iy3.
 inline __m128i interpolateGradients4(const short* d, std::ptrdiff_t step, const Bilinear& w) {
-  const __m128i v00 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(d));
-  const __m128i v01 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(d + 2));
-  const __m128i v10 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(d + step));
-  const __m128i v11 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(d + step + 2));
-  const __m128i round = _mm_set1_epi32(1 << (kWeightBits - 1));
-  __m128i lo =
-      _mm_add_epi32(_mm_add_epi32(_mm_madd_epi16(_mm_unpacklo_epi16(v00, v01), w.top), round),
-                    _mm_madd_epi16(_mm_unpacklo_epi16(v10, v11), w.bottom));
-  __m128i hi =
-      _mm_add_epi32(_mm_add_epi32(_mm_madd_epi16(_mm_unpackhi_epi16(v00, v01), w.top), round),
-                    _mm_madd_epi16(_mm_unpackhi_epi16(v10, v11), w.bottom));
-  return _mm_packs_epi32(_mm_srai_epi32(lo, kWeightBits), _mm_srai_epi32(hi, kWeightBits));
+  const auto load = [](const short* q) {
+    return _mm_loadu_si128(reinterpret_cast<const __m128i*>(q));
+  };
+  return interpolate<kWeightBits>(load(d), load(d + 2), load(d + step), load(d + step + 2), w);
 }
 
 // OpenCV's v_reduce_sum: (l0 + l2) + (l1 + l3).
