@@ -6,7 +6,8 @@
 // (5 of 21 pixels, 7 of 15) one pixel at a time: two integer interpolations per pixel and
 // iteration. Here every pixel is interpolated eight at a time, and only the float sums, whose
 // order fixes the result, go one by one. Other pyramids, other builds (no SSE2) and windows
-// narrower than 8 pixels go to OpenCV itself.
+// narrower than 8 pixels go to OpenCV itself. Bit for bit means against an OpenCV whose x86
+// baseline has no FMA (Debian's is SSE2); one built for FMA fuses some of those sums.
 
 #include <opencv2/core.hpp>
 #include <vector>
