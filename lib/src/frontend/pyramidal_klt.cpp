@@ -57,9 +57,9 @@ bool padded(const std::vector<cv::Mat>& pyramid, const PyramidLayout& layout, cv
          offset.y + level1.rows + window.height <= full.height;
 }
 
+// OpenCV's weights (w00, w01) and (w10, w11) as 16-bit pairs, for _mm_madd_epi16.
 struct Bilinear {
-  int w00, w01, w10, w11;
-  __m128i top, bottom;  // (w00, w01) and (w10, w11) as 16-bit pairs, for _mm_madd_epi16
+  __m128i top, bottom;
 };
 
 inline int pairOf(int left, int right) {
@@ -68,14 +68,11 @@ inline int pairOf(int left, int right) {
 }
 
 inline Bilinear bilinear(float a, float b) {
-  Bilinear w;
-  w.w00 = cvRound((1.f - a) * (1.f - b) * (1 << kWeightBits));
-  w.w01 = cvRound(a * (1.f - b) * (1 << kWeightBits));
-  w.w10 = cvRound((1.f - a) * b * (1 << kWeightBits));
-  w.w11 = (1 << kWeightBits) - w.w00 - w.w01 - w.w10;
-  w.top = _mm_set1_epi32(pairOf(w.w00, w.w01));
-  w.bottom = _mm_set1_epi32(pairOf(w.w10, w.w11));
-  return w;
+  const int w00 = cvRound((1.f - a) * (1.f - b) * (1 << kWeightBits));
+  const int w01 = cvRound(a * (1.f - b) * (1 << kWeightBits));
+  const int w10 = cvRound((1.f - a) * b * (1 << kWeightBits));
+  const int w11 = (1 << kWeightBits) - w00 - w01 - w10;
+  return {_mm_set1_epi32(pairOf(w00, w01)), _mm_set1_epi32(pairOf(w10, w11))};
 }
 
 // Bilinear interpolation of eight 16-bit values: v00 a row, v01 its right neighbours, v10 and
@@ -111,6 +108,14 @@ inline __m128i interpolateGradients4(const short* d, std::ptrdiff_t step, const 
   return interpolate<kWeightBits>(load(d), load(d + 2), load(d + step), load(d + step + 2), w);
 }
 
+// The x and y gradients of four interpolated pixels (Ix0 Iy0 Ix1 Iy1 ...) as floats.
+inline __m128 gradientX(__m128i g) {
+  return _mm_cvtepi32_ps(_mm_srai_epi32(_mm_slli_epi32(g, 16), 16));
+}
+inline __m128 gradientY(__m128i g) {
+  return _mm_cvtepi32_ps(_mm_srai_epi32(g, 16));
+}
+
 // OpenCV's v_reduce_sum: (l0 + l2) + (l1 + l3).
 inline float reduceSum(__m128 v) {
   v = _mm_add_ps(v, _mm_castsi128_ps(_mm_srli_si128(_mm_castps_si128(v), 8)));
@@ -130,7 +135,7 @@ class LevelTracker {
         width_(window.width),
         height_(window.height),
         simd_(8 * (window.width / 8)),
-        tail_(window.width - 8 * (window.width / 8)),
+        tail_(window.width % 8),
         level_(level),
         max_level_(max_level),
         max_iterations_(max_iterations),
@@ -197,7 +202,7 @@ class LevelTracker {
         break;
       }
       float b1, b2;
-      mismatch(inext, bilinear(next.x - inext.x, next.y - inext.y), buf, &b1, &b2);
+      mismatch(inext, bilinear(next.x - inext.x, next.y - inext.y), *buf, &b1, &b2);
       const cv::Point2f delta(static_cast<float>((A12 * b2 - A22 * b1) * D),
                               static_cast<float>((A12 * b1 - A11 * b2) * D));
       next += delta;
@@ -220,8 +225,7 @@ class LevelTracker {
     const std::ptrdiff_t step_d = static_cast<std::ptrdiff_t>(dI_.step / dI_.elemSize1());
     __m128 qA11 = _mm_setzero_ps(), qA12 = _mm_setzero_ps(), qA22 = _mm_setzero_ps();
     const auto accumulate = [&](__m128i g) {
-      const __m128 fx = _mm_cvtepi32_ps(_mm_srai_epi32(_mm_slli_epi32(g, 16), 16));
-      const __m128 fy = _mm_cvtepi32_ps(_mm_srai_epi32(g, 16));
+      const __m128 fx = gradientX(g), fy = gradientY(g);
       qA22 = _mm_add_ps(_mm_mul_ps(fy, fy), qA22);
       qA12 = _mm_add_ps(_mm_mul_ps(fx, fy), qA12);
       qA11 = _mm_add_ps(_mm_mul_ps(fx, fx), qA11);
@@ -256,8 +260,7 @@ class LevelTracker {
         float* ty = buf->tail_y.data() + 8 * y;
         for (int half = 0; half < 2; ++half) {
           const __m128i g = interpolateGradients4(dsrc + 2 * x + 8 * half, step_d, w);
-          const __m128 fx = _mm_cvtepi32_ps(_mm_srai_epi32(_mm_slli_epi32(g, 16), 16));
-          const __m128 fy = _mm_cvtepi32_ps(_mm_srai_epi32(g, 16));
+          const __m128 fx = gradientX(g), fy = gradientY(g);
           _mm_storeu_ps(tx + 4 * half, fx);
           _mm_storeu_ps(ty + 4 * half, fy);
           _mm_store_ps(p + 4 * half, _mm_mul_ps(fx, fx));
@@ -281,7 +284,7 @@ class LevelTracker {
 
   // The window around `at` in the second image against the template: the sums of the
   // differences times the gradients, in OpenCV's order.
-  void mismatch(cv::Point at, const Bilinear& w, Buffers* buf, float* b1, float* b2) const {
+  void mismatch(cv::Point at, const Bilinear& w, const Buffers& buf, float* b1, float* b2) const {
     const std::ptrdiff_t step_j = static_cast<std::ptrdiff_t>(J_.step / J_.elemSize1());
     __m128 qb0 = _mm_setzero_ps(), qb1 = _mm_setzero_ps();
     // OpenCV adds each row's remaining pixels one by one; added as each row ends, the chain
@@ -291,8 +294,8 @@ class LevelTracker {
     alignas(16) float p[16];
     for (int y = 0; y < height_; ++y) {
       const uchar* src = J_.ptr() + (y + at.y) * step_j + at.x;
-      const short* values = buf->values.data() + static_cast<std::ptrdiff_t>(y) * width_;
-      const short* paired = buf->paired.data() + static_cast<std::ptrdiff_t>(y) * 2 * simd_;
+      const short* values = buf.values.data() + static_cast<std::ptrdiff_t>(y) * width_;
+      const short* paired = buf.paired.data() + static_cast<std::ptrdiff_t>(y) * 2 * simd_;
       for (int x = 0; x < simd_; x += 8) {
         const __m128i diff =
             _mm_sub_epi16(interpolate8(src + x, step_j, w),
@@ -311,8 +314,8 @@ class LevelTracker {
                           _mm_loadu_si128(reinterpret_cast<const __m128i*>(values + x)));
         const __m128 d03 = _mm_cvtepi32_ps(_mm_srai_epi32(_mm_unpacklo_epi16(diff, diff), 16));
         const __m128 d47 = _mm_cvtepi32_ps(_mm_srai_epi32(_mm_unpackhi_epi16(diff, diff), 16));
-        const float* tx = buf->tail_x.data() + 8 * y;
-        const float* ty = buf->tail_y.data() + 8 * y;
+        const float* tx = buf.tail_x.data() + 8 * y;
+        const float* ty = buf.tail_y.data() + 8 * y;
         _mm_store_ps(p, _mm_mul_ps(d03, _mm_loadu_ps(tx)));
         _mm_store_ps(p + 4, _mm_mul_ps(d47, _mm_loadu_ps(tx + 4)));
         _mm_store_ps(p + 8, _mm_mul_ps(d03, _mm_loadu_ps(ty)));
