@@ -68,8 +68,6 @@ void PointTracker::flow(const std::vector<cv::Mat>& from_pyramid,
                         std::vector<uchar>* status, int levels) const {
   const cv::Size win(options_.klt_window, options_.klt_window);
   const cv::TermCriteria stop(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 30, 0.01);
-  // No error output (cv::noArray()): KLT's residual per point goes unused, and computing it
-  // costs about a tenth of the tracking.
   trackPyramidalKlt(from_pyramid, to_pyramid, from, to, status, win, levels, stop, !to->empty());
 }
 

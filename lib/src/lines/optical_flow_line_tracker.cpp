@@ -154,7 +154,6 @@ void OpticalFlowLineTracker::predict(const std::vector<cv::Mat>& pyramid, cv::Si
   }
   std::vector<cv::Point2f> moved;
   std::vector<uchar> status;
-  // Without KLT's error output, which nothing reads: about a tenth of the KLT time.
   trackPyramidalKlt(prev_pyramid_, pyramid, samples, &moved, &status, kltWindow(),
                     options_.flow.klt_pyramid_levels, kltStop(), false);
   for (std::size_t i = 0; i < moved.size(); ++i)

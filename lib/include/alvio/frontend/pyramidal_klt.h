@@ -17,7 +17,8 @@ namespace alvio {
 /// Same arguments and results as cv::calcOpticalFlowPyrLK(from_pyramid, to_pyramid, from, *to,
 /// *status, cv::noArray(), window, max_level, stop, use_initial_flow ?
 /// cv::OPTFLOW_USE_INITIAL_FLOW : 0), with OpenCV's default minimum eigenvalue (1e-4). `to`
-/// holds the initial guesses when `use_initial_flow` is set.
+/// holds the initial guesses when `use_initial_flow` is set. No per-point error: nothing reads
+/// it, and in OpenCV it costs about a tenth of the tracking.
 void trackPyramidalKlt(const std::vector<cv::Mat>& from_pyramid,
                        const std::vector<cv::Mat>& to_pyramid, const std::vector<cv::Point2f>& from,
                        std::vector<cv::Point2f>* to, std::vector<uchar>* status, cv::Size window,
