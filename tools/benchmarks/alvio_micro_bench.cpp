@@ -28,6 +28,7 @@
 #include "alvio/frontend/corner_detector.h"
 #include "alvio/frontend/gyro_rotation.h"
 #include "alvio/frontend/min_eigen_response.h"
+#include "alvio/frontend/optical_flow_pyramid.h"
 #include "alvio/frontend/point_tracker.h"
 #include "alvio/frontend/pyramidal_klt.h"
 #include "alvio/geometry/line_projection_factor.h"
@@ -219,6 +220,51 @@ void BM_KltAlvio(benchmark::State& state) {
                       kKltStop, false);
 }
 BENCHMARK(BM_KltAlvio)->Unit(benchmark::kMillisecond)->Arg(21)->Arg(15)->ArgName("window");
+
+// The KLT pyramid with gradients of one frame, 3 levels above the first: OpenCV's
+// buildOpticalFlowPyramid against alvio's buildOpticalFlowPyramid8u (the same bytes). Arg: the
+// window, whose size is the border's. On one thread, as alvio_run's timing runs: OpenCV would
+// split pyrDown over its pool.
+struct OneOpenCvThread {
+  OneOpenCvThread() : threads(cv::getNumThreads()) { cv::setNumThreads(1); }
+  ~OneOpenCvThread() { cv::setNumThreads(threads); }
+  int threads;
+};
+void BM_PyramidOpenCv(benchmark::State& state) {
+  const int window = static_cast<int>(state.range(0));
+  const OneOpenCvThread one_thread;
+  std::vector<cv::Mat> pyramid;
+  for (auto _ : state) {
+    pyramid.clear();  // a fresh pyramid, as the trackers build one per frame
+    cv::buildOpticalFlowPyramid(framePair().a, pyramid, cv::Size(window, window), 3, true,
+                                cv::BORDER_REFLECT_101, cv::BORDER_CONSTANT, false);
+  }
+}
+BENCHMARK(BM_PyramidOpenCv)->Unit(benchmark::kMillisecond)->Arg(21)->Arg(15)->ArgName("window");
+void BM_PyramidAlvio(benchmark::State& state) {
+  const int window = static_cast<int>(state.range(0));
+  const OneOpenCvThread one_thread;
+  std::vector<cv::Mat> pyramid;
+  for (auto _ : state) {
+    pyramid.clear();
+    buildOpticalFlowPyramid8u(framePair().a, cv::Size(window, window), 3, &pyramid);
+  }
+}
+BENCHMARK(BM_PyramidAlvio)->Unit(benchmark::kMillisecond)->Arg(21)->Arg(15)->ArgName("window");
+// The same, refilling the last pyramid's buffers, as the trackers do with the one from two
+// frames back.
+void BM_PyramidAlvioReused(benchmark::State& state) {
+  const int window = static_cast<int>(state.range(0));
+  const OneOpenCvThread one_thread;
+  std::vector<cv::Mat> pyramid;
+  for (auto _ : state)
+    buildOpticalFlowPyramid8u(framePair().a, cv::Size(window, window), 3, &pyramid);
+}
+BENCHMARK(BM_PyramidAlvioReused)
+    ->Unit(benchmark::kMillisecond)
+    ->Arg(21)
+    ->Arg(15)
+    ->ArgName("window");
 
 // New corners for a frame that still tracks 120: the point tracker's discs around those,
 // 30 wanted. OpenCV's goodFeaturesToTrack against alvio's CornerDetector (the same corners).

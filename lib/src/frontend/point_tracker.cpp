@@ -3,10 +3,10 @@
 #include <algorithm>
 #include <numeric>
 #include <opencv2/calib3d.hpp>
-#include <opencv2/video/tracking.hpp>
 #include <unordered_map>
 
 #include "alvio/common/error.h"
+#include "alvio/frontend/optical_flow_pyramid.h"
 #include "alvio/frontend/pyramidal_klt.h"
 #include "alvio/frontend/rotated_pixels.h"
 
@@ -136,11 +136,10 @@ FeatureFrame PointTracker::track(const cv::Mat& gray, int64_t t_ns, FrameTiming*
     const cv::Size win(options_.klt_window, options_.klt_window);
     // The image's pyramid and gradients, built once: the forward pass needs the previous
     // frame's, the backward pass this frame's, and this frame's serve the next frame again
-    // (calcOpticalFlowPyrLK on plain images would build them four times a frame). Never
-    // reuse the caller's buffer (tryReuseInputImage = false).
-    std::vector<cv::Mat> pyramid;
-    cv::buildOpticalFlowPyramid(img, pyramid, win, options_.klt_levels, true,
-                                cv::BORDER_REFLECT_101, cv::BORDER_CONSTANT, false);
+    // (calcOpticalFlowPyrLK on plain images would build them four times a frame). Built into
+    // the buffers of the pyramid from two frames back; never into the caller's image.
+    std::vector<cv::Mat> pyramid = std::move(spare_pyramid_);
+    buildOpticalFlowPyramid8u(img, win, options_.klt_levels, &pyramid);
     if (!prev_pyramid_.empty() && !pts_.empty()) {
       std::vector<cv::Point2f> next;
       std::vector<uchar> status;
@@ -188,6 +187,7 @@ FeatureFrame PointTracker::track(const cv::Mat& gray, int64_t t_ns, FrameTiming*
       ids_.clear();
       track_counts_.clear();
     }
+    spare_pyramid_ = std::move(prev_pyramid_);
     prev_pyramid_ = std::move(pyramid);
     for (int& c : track_counts_) ++c;
   }

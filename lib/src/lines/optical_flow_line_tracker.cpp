@@ -3,8 +3,8 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
-#include <opencv2/video/tracking.hpp>
 
+#include "alvio/frontend/optical_flow_pyramid.h"
 #include "alvio/frontend/pyramidal_klt.h"
 #include "alvio/frontend/rotated_pixels.h"
 
@@ -260,12 +260,11 @@ void OpticalFlowLineTracker::associate(const cv::Mat& undistorted,
                                        const std::vector<LineSegment>& detections, bool detected,
                                        LineFrame* frame) {
   const auto& f = options_.flow;
-  std::vector<cv::Mat> pyramid;
-  // Built once per frame and kept as the next frame's previous pyramid. Never share the
-  // caller's buffer (tryReuseInputImage = false): it may be overwritten after we return.
-  cv::buildOpticalFlowPyramid(undistorted, pyramid, cv::Size(f.klt_window_px, f.klt_window_px),
-                              f.klt_pyramid_levels, true, cv::BORDER_REFLECT_101,
-                              cv::BORDER_CONSTANT, false);
+  // Built once per frame and kept as the next frame's previous pyramid, into the buffers of
+  // the one from two frames back. Never the caller's buffer: it may be overwritten after we
+  // return.
+  std::vector<cv::Mat> pyramid = std::move(spare_pyramid_);
+  buildOpticalFlowPyramid8u(undistorted, kltWindow(), f.klt_pyramid_levels, &pyramid);
   predict(pyramid, undistorted.size());
   std::vector<Track> next = detected ? match(detections, frame) : carryPredictions(frame);
 
@@ -279,6 +278,7 @@ void OpticalFlowLineTracker::associate(const cv::Mat& undistorted,
     frame->lines.push_back(obs);
   }
   tracks_ = std::move(next);
+  spare_pyramid_ = std::move(prev_pyramid_);
   prev_pyramid_ = std::move(pyramid);
 }
 

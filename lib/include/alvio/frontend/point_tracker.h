@@ -80,7 +80,8 @@ class PointTracker {
   Clahe clahe_;
   CornerDetector corners_;
   PatchAnchors anchors_;
-  std::vector<cv::Mat> prev_pyramid_;  // with gradients, for KLT
+  std::vector<cv::Mat> prev_pyramid_;   // with gradients, for KLT
+  std::vector<cv::Mat> spare_pyramid_;  // the one before, whose buffers the next frame refills
   int64_t prev_t_ns_ = 0;
   std::vector<cv::Point2f> pts_;
   std::vector<int> ids_, track_counts_;

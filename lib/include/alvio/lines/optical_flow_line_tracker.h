@@ -73,6 +73,7 @@ class OpticalFlowLineTracker final : public LineTracker {
 
   std::vector<Track> tracks_;
   std::vector<cv::Mat> prev_pyramid_;
+  std::vector<cv::Mat> spare_pyramid_;  // the one before, whose buffers the next frame refills
   std::vector<Prediction> predictions_;
   int frames_since_detection_ = 0;
 };
