@@ -4,6 +4,7 @@
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
 #include <unordered_set>
 
 namespace alvio {
@@ -86,20 +87,28 @@ bool PatchAnchors::anchor(int id, const cv::Mat& image, const cv::Point2f& p) {
   // The normal matrix's upper triangle, mirrored after: each entry sums the same products in
   // the same order as the whole outer product g g^T, in about half the work.
   double upper[kUpperSize] = {};
-  const auto add_outer = k_params_ == 6   ? &addOuterUpper<6>
-                         : k_params_ == 4 ? &addOuterUpper<4>
-                                          : &addOuterUpper<2>;
   patch.sum_sd.setZero();
   patch.sum_sd_t.setZero();
-  for (int k = 0; k < n * n; ++k) {
-    patch.values[k] -= mean;
-    ss += patch.values[k] * patch.values[k];
-    Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
-    for (int i = 0; i < k_params_; ++i) g[i] = patch.sd[i][k];
-    add_outer(g.data(), upper);
-    patch.sum_sd += g;
-    patch.sum_sd_t += g * patch.values[k];
-  }
+  // One loop per parameter count, so that the outer product is inlined with its sums kept in
+  // registers.
+  const auto accumulate = [&](auto parameters) {
+    constexpr int K = decltype(parameters)::value;
+    for (int k = 0; k < n * n; ++k) {
+      patch.values[k] -= mean;
+      ss += patch.values[k] * patch.values[k];
+      Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
+      for (int i = 0; i < K; ++i) g[i] = patch.sd[i][k];
+      addOuterUpper<K>(g.data(), upper);
+      patch.sum_sd += g;
+      patch.sum_sd_t += g * patch.values[k];
+    }
+  };
+  if (k_params_ == 6)
+    accumulate(std::integral_constant<int, 6>());
+  else if (k_params_ == 4)
+    accumulate(std::integral_constant<int, 4>());
+  else
+    accumulate(std::integral_constant<int, 2>());
   Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
   for (int i = 0, t = 0; i < k_params_; ++i)
     for (int j = i; j < k_params_; ++j, ++t) H(i, j) = H(j, i) = upper[t];
