@@ -3,6 +3,8 @@
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 
+#include "alvio/common/widest_vectors.h"
+
 namespace alvio {
 
 namespace {
@@ -16,15 +18,6 @@ void padReflect101(std::vector<int32_t>* row, int w) {
   (*row)[0] = (*row)[2];
   (*row)[w + 1] = (*row)[w - 1];
 }
-
-// The row loops below are plain code the compiler vectorises; GCC builds them twice, for AVX2
-// and for the baseline, and picks one when the library loads. Integer sums and one rounding per
-// float operation (no FMA in either): the same response either way.
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
-#define ALVIO_WIDEST_VECTORS __attribute__((target_clones("avx2", "default")))
-#else
-#define ALVIO_WIDEST_VECTORS
-#endif
 
 // o = u + v + t, element-wise; restrict lets the compiler vectorise it.
 ALVIO_WIDEST_VECTORS

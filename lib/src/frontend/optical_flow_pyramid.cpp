@@ -4,13 +4,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
 
-// Built twice, for AVX2 and for the baseline, and chosen when the library loads (GCC's
-// function multi-versioning). The loops are plain integer code the compiler vectorises.
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
-#define ALVIO_WIDEST_VECTORS __attribute__((target_clones("avx2", "default")))
-#else
-#define ALVIO_WIDEST_VECTORS
-#endif
+#include "alvio/common/widest_vectors.h"
 
 namespace alvio {
 namespace {
