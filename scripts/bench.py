@@ -23,6 +23,12 @@ A nudge samples little of a run's chaos; other noise seeds sample more (on sim_M
 rendering: seed 1 is --data's set, seed S the copy in DATA/seedS (alvio sim --benchmark
 DATA/seedS --seed S, which --render makes). The tables then give the mean over the seeds (and
 repeats) with its range, and --compare the ratio of each seed's pair.
+
+This machine's speed drifts by up to 1.4x within minutes, more than a small speed change.
+--side-by-side (with --compare) starts each pair of runs (same sequence, seed and repeat) at
+the same moment, one variant on each of two cores (swapped from pair to pair), so that a drift
+slows both alike; the compare table then ends with the pooled ratio of the pairs' median frame
+times. The two runs share the memory bus and caches, so compare its times only with each other.
 """
 import argparse
 import csv
@@ -108,12 +114,14 @@ class Run:
         self.wall_s = None
         self.rc = None
 
-    def start(self):
+    def start(self, cpu=None):
+        """Starts the run; on core `cpu` alone when given."""
         self.out.mkdir(parents=True, exist_ok=True)
         self.log = open(self.out / "run.log", "w")
         self.t0 = time.monotonic()
+        pin = None if cpu is None else (lambda: os.sched_setaffinity(0, {cpu}))
         self.proc = subprocess.Popen(self.cmd, stdout=self.log, stderr=subprocess.STDOUT,
-                                     env=program_env(self.cmd[0]))
+                                     env=program_env(self.cmd[0]), preexec_fn=pin)
 
     def reap(self, status, rusage):
         self.wall_s = time.monotonic() - self.t0
@@ -272,13 +280,22 @@ def aggregate(results):
     return out
 
 
-def run_all(runs, jobs):
-    """Start runs in order (interleaved by the caller), at most `jobs` at a time."""
+def run_all(runs, jobs, side_by_side=False):
+    """Start runs in order (interleaved by the caller), at most `jobs` at a time. Side by side:
+    each pair of consecutive runs at once, on cores 0 and 1, swapped from one pair to the next;
+    the next pair only once both have ended."""
     pending = list(runs)
     active = {}
     done = 0
+    pairs = 0
     while pending or active:
-        while pending and len(active) < jobs:
+        if side_by_side and not active:
+            for r, cpu in zip(pending[:2], (0, 1) if pairs % 2 == 0 else (1, 0)):
+                r.start(cpu)
+                active[r.proc.pid] = r
+            del pending[:2]
+            pairs += 1
+        while not side_by_side and pending and len(active) < jobs:
             r = pending.pop(0)
             r.start()
             active[r.proc.pid] = r
@@ -383,7 +400,21 @@ def pooled_line(per_run, a, b):
             f"{lo:.3f}–{hi:.3f}); {better} of {n} runs lower with {b}.")
 
 
-def compare_table(results, a, b, per_run=None):
+def paired_time_line(per_run, a, b):
+    """The B/A ratios of the paired runs' median frame times, pooled (for --side-by-side)."""
+    medians = {(r["sequence"], r.get("seed", 1), r.get("repeat", 0), r["variant"]):
+               (r.get("timing") or {}).get("total", {}).get("median") for r in per_run}
+    ratios = [ratio(t, medians.get((q, s, k, b))) for (q, s, k, v), t in medians.items()
+              if v == a]
+    pooled = pooled_ratio(ratios)
+    if pooled is None:
+        return ""
+    g, lo, hi, n = pooled
+    return (f"Median frame time {b}/{a} over the {n} pairs: {g:.3f} (geometric mean; 95 % "
+            f"interval {lo:.3f}–{hi:.3f}).")
+
+
+def compare_table(results, a, b, per_run=None, side_by_side=False):
     """Ratios B/A. With per_run from several seeds, also each seed's ATE ratio."""
     seeds = sorted({r.get("seed", 1) for r in per_run or []})
     each = len(seeds) > 1
@@ -404,6 +435,9 @@ def compare_table(results, a, b, per_run=None):
             f"| {fmt(ratio(ra.get('opt_total_median'), rb.get('opt_total_median')), '.3f')} "
             f"| {fmt(ratio(ra.get('peak_rss_mb'), rb.get('peak_rss_mb')), '.3f')} |")
     pooled = pooled_line(per_run or [], a, b)
+    if side_by_side:
+        times = paired_time_line(per_run or [], a, b)
+        pooled = f"{pooled}\n\n{times}" if pooled and times else pooled or times
     return "\n".join(lines) + (f"\n\n{pooled}" if pooled else "")
 
 
@@ -438,6 +472,10 @@ def main():
     ap.add_argument("--ablation", action="store_true", help="the paper's four selection configurations")
     ap.add_argument("--out", default=str(ROOT / "out" / "bench"), help="run folders and tables [%(default)s]")
     ap.add_argument("--jobs", type=int, default=1, help="runs at once [%(default)s]")
+    ap.add_argument("--side-by-side", action="store_true",
+                    help="with --compare: each pair of runs at once, one variant per core "
+                    "(swapped from pair to pair), and the pooled ratio of their median frame "
+                    "times; needs two cores")
     ap.add_argument("--max-frames", type=int, default=-1, help="stop each run after this many images")
     ap.add_argument("--opencv-threads", type=int, default=1,
                     help="alvio run's --opencv-threads: 1 keeps each run on one core (issue 10's "
@@ -463,6 +501,11 @@ def main():
     a = ap.parse_args()
     if a.repeats < 1:
         sys.exit("alvio bench: error: --repeats must be at least 1")
+    if a.side_by_side and not a.compare:
+        sys.exit("alvio bench: error: --side-by-side needs --compare A B")
+    if a.side_by_side and not {0, 1} <= os.sched_getaffinity(0):
+        sys.exit("alvio bench: error: --side-by-side needs cores 0 and 1, this process may use "
+                 f"{sorted(os.sched_getaffinity(0))}")
     try:
         seeds = [int(x) for x in a.seeds.split(",")]
     except ValueError:
@@ -558,8 +601,9 @@ def main():
             for name, d, seed in datasets for k in range(a.repeats) for v, args in parsed]
     log(f"{len(runs)} runs ({len(seqs)} sequences"
         f"{f' x {len(seeds)} seeds' if len(seeds) > 1 else ''} x {len(parsed)} variants"
-        f"{f' x {a.repeats} repeats' if a.repeats > 1 else ''}), {a.jobs} at a time, into {out}")
-    run_all(runs, a.jobs)
+        f"{f' x {a.repeats} repeats' if a.repeats > 1 else ''}), "
+        f"{'pairs side by side' if a.side_by_side else f'{a.jobs} at a time'}, into {out}")
+    run_all(runs, a.jobs, a.side_by_side)
     per_run = [r.result() for r in runs]
     (out / "results.json").write_text(json.dumps(per_run, indent=2))
     results = aggregate(per_run)
@@ -570,7 +614,8 @@ def main():
     else:
         text = bench_table(results)
         if a.compare:
-            text += "\n\n" + compare_table(results, parsed[0][0], parsed[1][0], per_run)
+            text += "\n\n" + compare_table(results, parsed[0][0], parsed[1][0], per_run,
+                                            a.side_by_side)
     if seeds != [1]:
         text += (f"\n\nEach row: the runs on noise seeds {a.seeds} (seed S > 1: {data}/seedS)"
                  f"{f', {a.repeats} each' if a.repeats > 1 else ''}; ATE is their mean (range), "

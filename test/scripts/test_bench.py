@@ -268,13 +268,18 @@ class TablesTest(unittest.TestCase):
 
 FAKE_RUN = """#!/usr/bin/python3
 # Stand-in for alvio_run: records its arguments and copies the prepared run files.
-import json, os, shutil, sys
+import json, os, shutil, sys, time
 from pathlib import Path
 argv = sys.argv[1:]
 out = Path(argv[argv.index("--out") + 1])
 seq = Path(argv[argv.index("--dataset") + 1]).name
 variant = "points" if "--no-lines" in argv else "lines"
 (out / "argv.json").write_text(json.dumps(argv))
+# The cores it may use and when it ran (FAKE_SLEEP: seconds to take).
+start = time.monotonic()
+time.sleep(float(os.environ.get("FAKE_SLEEP", "0")))
+(out / "ran.json").write_text(json.dumps({"cpus": sorted(os.sched_getaffinity(0)),
+                                          "start": start, "end": time.monotonic()}))
 print(f"fake alvio_run: {seq} {variant}")
 # FAKE_FIXTURES: where the prepared files are when this script runs from a frozen copy.
 src = Path(os.environ.get("FAKE_FIXTURES", Path(__file__).parent / "fixtures")) / seq / variant
@@ -359,6 +364,26 @@ class RepeatsTest(unittest.TestCase):
         self.assertIsNone(a["timing"])
 
 
+class PairedTimeTest(unittest.TestCase):
+    def test_pools_the_pairs_median_frame_times(self):
+        per_run = []
+        for k, (ta, tb) in enumerate([(10.0, 9.0), (12.0, 11.4), (11.0, 10.0)]):
+            run = {"sequence": "s", "seed": 1, "repeat": k, "rc": 0, "ate": 0.1}
+            per_run.append(run | {"variant": "a", "timing": {"total": {"median": ta}}})
+            per_run.append(run | {"variant": "b", "timing": {"total": {"median": tb}}})
+        logs = [math.log(0.9), math.log(0.95), math.log(10 / 11)]
+        mean = sum(logs) / 3
+        sd = math.sqrt(sum((x - mean) ** 2 for x in logs) / 2)
+        half = 4.303 * sd / math.sqrt(3)  # t, 2 degrees of freedom
+        expected = (f"Median frame time b/a over the 3 pairs: {math.exp(mean):.3f} (geometric "
+                    f"mean; 95 % interval {math.exp(mean - half):.3f}–{math.exp(mean + half):.3f}).")
+        self.assertEqual(bench.paired_time_line(per_run, "a", "b"), expected)
+        text = bench.compare_table(bench.aggregate(per_run), "a", "b", per_run, side_by_side=True)
+        self.assertIn(expected, text)
+        self.assertNotIn("Median frame time", bench.compare_table(bench.aggregate(per_run), "a",
+                                                                  "b", per_run))
+
+
 class MainTest(unittest.TestCase):
     """bench.py as ./alvio bench runs it, with --bin pointing at FAKE_RUN."""
 
@@ -381,10 +406,10 @@ class MainTest(unittest.TestCase):
     def tearDown(self):
         self.tmp.cleanup()
 
-    def bench(self, *args):
+    def bench(self, *args, sleep=0.0):
         # FAKE_FIXTURES: the fixtures also for a frozen copy of FAKE_RUN (--freeze).
         env = dict(os.environ, PYTHONDONTWRITEBYTECODE="1",
-                   FAKE_FIXTURES=str(self.fake.parent / "fixtures"))
+                   FAKE_FIXTURES=str(self.fake.parent / "fixtures"), FAKE_SLEEP=str(sleep))
         return subprocess.run(["/usr/bin/python3", str(SCRIPTS / "bench.py"),
                                "--data", str(self.data), "--out", str(self.dir / "out"),
                                "--bin", str(self.fake), *args],
@@ -466,6 +491,31 @@ class MainTest(unittest.TestCase):
         ate_lines = self.inputs["sim_A", "lines"]["summary"]["ate_rmse_m"]
         self.assertEqual(row[:4], ["sim_A", f"{ate_points:.4f}", f"{ate_lines:.4f}",
                                    f"{ate_lines / ate_points:.3f}"])
+
+    @unittest.skipUnless({0, 1} <= os.sched_getaffinity(0), "needs cores 0 and 1")
+    def test_side_by_side_runs_each_pair_at_once_on_swapped_cores(self):
+        p = self.bench("--sequences", "sim_A", "--compare", "points", "lines", "--repeats", "3",
+                       "--side-by-side", sleep=0.3)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        out = self.dir / "out" / "sim_A"
+        ran = {(v, k): json.loads((out / v / f"r{k}" / "ran.json").read_text())
+               for v in ("points", "lines") for k in range(3)}
+        # One core each, swapped from one pair to the next.
+        self.assertEqual([(ran["points", k]["cpus"], ran["lines", k]["cpus"]) for k in range(3)],
+                         [([0], [1]), ([1], [0]), ([0], [1])])
+        for k in range(3):
+            a, b = ran["points", k], ran["lines", k]
+            self.assertLess(max(a["start"], b["start"]), min(a["end"], b["end"]))  # overlapping
+            if k:  # the next pair only once both of the last have ended
+                last = max(ran["points", k - 1]["end"], ran["lines", k - 1]["end"])
+                self.assertGreaterEqual(min(a["start"], b["start"]), last)
+        self.assertIn("Median frame time lines/points over the 3 pairs:", p.stdout)
+        self.assertIn("pairs side by side", p.stderr)
+
+    def test_side_by_side_needs_compare(self):
+        p = self.bench("--sequences", "sim_A", "--variants", "points,lines", "--side-by-side")
+        self.assertNotEqual(p.returncode, 0)
+        self.assertIn("--side-by-side needs --compare", p.stderr)
 
     def test_repeats_nudge_the_noise_setting_and_average(self):
         p = self.bench("--sequences", "sim_A", "--variants", "points,lines", "--repeats", "3")
