@@ -401,17 +401,22 @@ def pooled_line(per_run, a, b):
 
 
 def paired_time_line(per_run, a, b):
-    """The B/A ratios of the paired runs' median frame times, pooled (for --side-by-side)."""
+    """The B/A ratios of the paired runs' median frame times (--side-by-side), pooled. The two
+    cores of this machine can differ in speed by 1.4x for minutes, and consecutive pairs swap
+    them, so each two consecutive pairs' ratios are combined (their geometric mean) before
+    pooling: a constant difference between the cores then cancels."""
     medians = {(r["sequence"], r.get("seed", 1), r.get("repeat", 0), r["variant"]):
                (r.get("timing") or {}).get("total", {}).get("median") for r in per_run}
     ratios = [ratio(t, medians.get((q, s, k, b))) for (q, s, k, v), t in medians.items()
               if v == a]
-    pooled = pooled_ratio(ratios)
+    blocks = [math.sqrt(x * y) for x, y in zip(ratios[0::2], ratios[1::2])
+              if x is not None and y is not None and x > 0 and y > 0]
+    pooled = pooled_ratio(blocks)
     if pooled is None:
         return ""
     g, lo, hi, n = pooled
-    return (f"Median frame time {b}/{a} over the {n} pairs: {g:.3f} (geometric mean; 95 % "
-            f"interval {lo:.3f}–{hi:.3f}).")
+    return (f"Median frame time {b}/{a} over {n} blocks of two pairs with the cores swapped: "
+            f"{g:.3f} (geometric mean; 95 % interval {lo:.3f}–{hi:.3f}).")
 
 
 def compare_table(results, a, b, per_run=None, side_by_side=False):

@@ -365,19 +365,26 @@ class RepeatsTest(unittest.TestCase):
 
 
 class PairedTimeTest(unittest.TestCase):
-    def test_pools_the_pairs_median_frame_times(self):
-        per_run = []
-        for k, (ta, tb) in enumerate([(10.0, 9.0), (12.0, 11.4), (11.0, 10.0)]):
+    def test_pools_blocks_of_two_pairs_with_the_cores_swapped(self):
+        # B is 0.9x A; the second core runs 1.4x slower, and the pairs swap cores: B on the
+        # slow core in pairs 0 and 2, A in pairs 1 and 3. A fifth pair has no partner.
+        slow, per_run = 1.4, []
+        for k in range(5):
+            ta, tb = (10.0, 9.0 * slow) if k % 2 == 0 else (10.0 * slow, 9.0)
+            tb *= 1.0 + 0.01 * k  # a little noise that stays
             run = {"sequence": "s", "seed": 1, "repeat": k, "rc": 0, "ate": 0.1}
             per_run.append(run | {"variant": "a", "timing": {"total": {"median": ta}}})
             per_run.append(run | {"variant": "b", "timing": {"total": {"median": tb}}})
-        logs = [math.log(0.9), math.log(0.95), math.log(10 / 11)]
-        mean = sum(logs) / 3
-        sd = math.sqrt(sum((x - mean) ** 2 for x in logs) / 2)
-        half = 4.303 * sd / math.sqrt(3)  # t, 2 degrees of freedom
-        expected = (f"Median frame time b/a over the 3 pairs: {math.exp(mean):.3f} (geometric "
-                    f"mean; 95 % interval {math.exp(mean - half):.3f}–{math.exp(mean + half):.3f}).")
+        blocks = [0.9 * math.sqrt(1.00 * 1.01), 0.9 * math.sqrt(1.02 * 1.03)]
+        logs = [math.log(x) for x in blocks]
+        mean = sum(logs) / 2
+        sd = math.sqrt(sum((x - mean) ** 2 for x in logs))
+        half = 12.706 * sd / math.sqrt(2)  # t, 1 degree of freedom
+        expected = (f"Median frame time b/a over 2 blocks of two pairs with the cores swapped: "
+                    f"{math.exp(mean):.3f} (geometric mean; 95 % interval "
+                    f"{math.exp(mean - half):.3f}–{math.exp(mean + half):.3f}).")
         self.assertEqual(bench.paired_time_line(per_run, "a", "b"), expected)
+        self.assertIn(": 0.913 (geometric mean", expected)  # 0.9 x 1.015: the 1.4 cancelled
         text = bench.compare_table(bench.aggregate(per_run), "a", "b", per_run, side_by_side=True)
         self.assertIn(expected, text)
         self.assertNotIn("Median frame time", bench.compare_table(bench.aggregate(per_run), "a",
@@ -494,22 +501,25 @@ class MainTest(unittest.TestCase):
 
     @unittest.skipUnless({0, 1} <= os.sched_getaffinity(0), "needs cores 0 and 1")
     def test_side_by_side_runs_each_pair_at_once_on_swapped_cores(self):
-        p = self.bench("--sequences", "sim_A", "--compare", "points", "lines", "--repeats", "3",
+        p = self.bench("--sequences", "sim_A", "--compare", "points", "lines", "--repeats", "4",
                        "--side-by-side", sleep=0.3)
         self.assertEqual(p.returncode, 0, p.stderr)
         out = self.dir / "out" / "sim_A"
         ran = {(v, k): json.loads((out / v / f"r{k}" / "ran.json").read_text())
-               for v in ("points", "lines") for k in range(3)}
+               for v in ("points", "lines") for k in range(4)}
         # One core each, swapped from one pair to the next.
-        self.assertEqual([(ran["points", k]["cpus"], ran["lines", k]["cpus"]) for k in range(3)],
-                         [([0], [1]), ([1], [0]), ([0], [1])])
-        for k in range(3):
+        self.assertEqual([(ran["points", k]["cpus"], ran["lines", k]["cpus"]) for k in range(4)],
+                         [([0], [1]), ([1], [0]), ([0], [1]), ([1], [0])])
+        for k in range(4):
             a, b = ran["points", k], ran["lines", k]
             self.assertLess(max(a["start"], b["start"]), min(a["end"], b["end"]))  # overlapping
             if k:  # the next pair only once both of the last have ended
                 last = max(ran["points", k - 1]["end"], ran["lines", k - 1]["end"])
                 self.assertGreaterEqual(min(a["start"], b["start"]), last)
-        self.assertIn("Median frame time lines/points over the 3 pairs:", p.stdout)
+        lines = self.inputs["sim_A", "lines"]["summary"]["timing_ms"]["total"]["median"]
+        points = self.inputs["sim_A", "points"]["summary"]["timing_ms"]["total"]["median"]
+        self.assertIn(f"Median frame time lines/points over 2 blocks of two pairs with the cores "
+                      f"swapped: {lines / points:.3f}", p.stdout)
         self.assertIn("pairs side by side", p.stderr)
 
     def test_side_by_side_needs_compare(self):
