@@ -13,10 +13,10 @@ int reflect101(int i, int n) {
   return i < 0 ? -i : (i >= n ? 2 * n - 2 - i : i);
 }
 
-// Fill the one-pixel pads of a row stored from index 1.
-void padReflect101(std::vector<int32_t>* row, int w) {
-  (*row)[0] = (*row)[2];
-  (*row)[w + 1] = (*row)[w - 1];
+// Fill the one-pixel pads of a row of w values stored from index 1.
+inline void padReflect101(int32_t* row, int w) {
+  row[0] = row[2];
+  row[w + 1] = row[w - 1];
 }
 
 // o = u + v + t, element-wise; restrict lets the compiler vectorise it.
@@ -38,11 +38,8 @@ void sobelProducts(const uchar* __restrict up, const uchar* __restrict mid,
     s[x + 1] = up[x] + 2 * mid[x] + down[x];
     d[x + 1] = down[x] - up[x];
   }
-  // Reflect-101 pads (OpenCV's default border).
-  s[0] = s[2];
-  s[w + 1] = s[w - 1];
-  d[0] = d[2];
-  d[w + 1] = d[w - 1];
+  padReflect101(s, w);
+  padReflect101(d, w);
   for (int x = 0; x < w; ++x) {
     const int32_t gx = s[x + 2] - s[x];
     const int32_t gy = d[x] + 2 * d[x + 1] + d[x + 2];
@@ -103,9 +100,9 @@ void MinEigenResponse::compute(const cv::Mat& image, cv::Mat* response) {
     int32_t* sums[3] = {sum_xx_.data() + 1, sum_xy_.data() + 1, sum_yy_.data() + 1};
     for (int k = 0; k < 3; ++k)
       addRows(rows[0] + k * w, rows[1] + k * w, rows[2] + k * w, sums[k], w);
-    padReflect101(&sum_xx_, w);
-    padReflect101(&sum_xy_, w);
-    padReflect101(&sum_yy_, w);
+    padReflect101(sum_xx_.data(), w);
+    padReflect101(sum_xy_.data(), w);
+    padReflect101(sum_yy_.data(), w);
     minEigenRow(sum_xx_.data(), sum_xy_.data(), sum_yy_.data(), w, half_scale2,
                 response->ptr<float>(y));
   }
