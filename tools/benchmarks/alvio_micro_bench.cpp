@@ -241,30 +241,22 @@ void BM_PyramidOpenCv(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_PyramidOpenCv)->Unit(benchmark::kMillisecond)->Arg(21)->Arg(15)->ArgName("window");
+// Second arg, refill: 1 builds into the last pyramid's buffers, as the trackers do with the one
+// from two frames back; 0 into fresh ones, as OpenCV's above.
 void BM_PyramidAlvio(benchmark::State& state) {
   const int window = static_cast<int>(state.range(0));
+  const bool refill = state.range(1) != 0;
   const OneOpenCvThread one_thread;
   std::vector<cv::Mat> pyramid;
   for (auto _ : state) {
-    pyramid.clear();
+    if (!refill) pyramid.clear();
     buildOpticalFlowPyramid8u(framePair().a, cv::Size(window, window), 3, &pyramid);
   }
 }
-BENCHMARK(BM_PyramidAlvio)->Unit(benchmark::kMillisecond)->Arg(21)->Arg(15)->ArgName("window");
-// The same, refilling the last pyramid's buffers, as the trackers do with the one from two
-// frames back.
-void BM_PyramidAlvioReused(benchmark::State& state) {
-  const int window = static_cast<int>(state.range(0));
-  const OneOpenCvThread one_thread;
-  std::vector<cv::Mat> pyramid;
-  for (auto _ : state)
-    buildOpticalFlowPyramid8u(framePair().a, cv::Size(window, window), 3, &pyramid);
-}
-BENCHMARK(BM_PyramidAlvioReused)
+BENCHMARK(BM_PyramidAlvio)
     ->Unit(benchmark::kMillisecond)
-    ->Arg(21)
-    ->Arg(15)
-    ->ArgName("window");
+    ->ArgsProduct({{21, 15}, {0, 1}})
+    ->ArgNames({"window", "refill"});
 
 // New corners for a frame that still tracks 120: the point tracker's discs around those,
 // 30 wanted. OpenCV's goodFeaturesToTrack against alvio's CornerDetector (the same corners).
