@@ -357,13 +357,18 @@ def ratio(a, b):
     return None if a is None or b is None or a == 0 else b / a
 
 
-def paired_ratios(per_run, seq, a, b):
-    """B/A ATE ratios of the runs that share sequence, seed and repeat, in seed order."""
-    ates = {(r["variant"], r.get("seed", 1), r.get("repeat", 0)): r.get("ate")
-            for r in per_run if r["sequence"] == seq}
-    return [ratio(ates[(a, s, k)], ates[(b, s, k)])
-            for (v, s, k) in sorted(ates, key=lambda key: (key[1], key[2]))
-            if v == a and (b, s, k) in ates]
+def median_frame_ms(run):
+    return (run.get("timing") or {}).get("total", {}).get("median")
+
+
+def paired_ratios(per_run, seq, a, b, value=lambda r: r.get("ate")):
+    """B/A ratios of `value` (ATE unless given) of the runs that share sequence, seed and
+    repeat, in seed and repeat order: the order they ran in."""
+    values = {(r["variant"], r.get("seed", 1), r.get("repeat", 0)): value(r)
+              for r in per_run if r["sequence"] == seq}
+    return [ratio(values[(a, s, k)], values[(b, s, k)])
+            for (v, s, k) in sorted(values, key=lambda key: (key[1], key[2]))
+            if v == a and (b, s, k) in values]
 
 
 # Two-sided 95 % quantiles of Student's t for 1..30 degrees of freedom; 1.96 beyond.
@@ -388,7 +393,7 @@ def pooled_ratio(ratios):
 
 
 def pooled_line(per_run, a, b):
-    """The compare table's last line: every paired run's B/A ATE ratio, pooled."""
+    """The compare table's pooled ATE line: every paired run's B/A ATE ratio, pooled."""
     ratios = [x for seq in dict.fromkeys(r["sequence"] for r in per_run)
               for x in paired_ratios(per_run, seq, a, b) if x is not None]
     pooled = pooled_ratio(ratios)
@@ -405,10 +410,8 @@ def paired_time_line(per_run, a, b):
     cores of this machine can differ in speed by 1.4x for minutes, and consecutive pairs swap
     them, so each two consecutive pairs' ratios are combined (their geometric mean) before
     pooling: a constant difference between the cores then cancels."""
-    medians = {(r["sequence"], r.get("seed", 1), r.get("repeat", 0), r["variant"]):
-               (r.get("timing") or {}).get("total", {}).get("median") for r in per_run}
-    ratios = [ratio(t, medians.get((q, s, k, b))) for (q, s, k, v), t in medians.items()
-              if v == a]
+    ratios = [x for seq in dict.fromkeys(r["sequence"] for r in per_run)
+              for x in paired_ratios(per_run, seq, a, b, median_frame_ms)]
     blocks = [math.sqrt(x * y) for x, y in zip(ratios[0::2], ratios[1::2])
               if x is not None and y is not None and x > 0 and y > 0]
     pooled = pooled_ratio(blocks)
@@ -439,11 +442,10 @@ def compare_table(results, a, b, per_run=None, side_by_side=False):
             f"{fmt(ratio(stage(ra, 'total'), stage(rb, 'total')), '.3f')} "
             f"| {fmt(ratio(ra.get('opt_total_median'), rb.get('opt_total_median')), '.3f')} "
             f"| {fmt(ratio(ra.get('peak_rss_mb'), rb.get('peak_rss_mb')), '.3f')} |")
-    pooled = pooled_line(per_run or [], a, b)
+    tail = [pooled_line(per_run or [], a, b)]
     if side_by_side:
-        times = paired_time_line(per_run or [], a, b)
-        pooled = f"{pooled}\n\n{times}" if pooled and times else pooled or times
-    return "\n".join(lines) + (f"\n\n{pooled}" if pooled else "")
+        tail.append(paired_time_line(per_run or [], a, b))
+    return "\n\n".join(["\n".join(lines)] + [t for t in tail if t])
 
 
 def ablation_table(results, seq):
