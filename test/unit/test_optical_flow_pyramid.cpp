@@ -1,5 +1,6 @@
 // alvio::buildOpticalFlowPyramid8u builds cv::buildOpticalFlowPyramid's pyramid with gradients
-// byte for byte, borders included, and falls back to OpenCV where it does not apply.
+// byte for byte, borders included, and falls back to OpenCV where it does not apply;
+// alvio::PyramidHistory builds each frame's pyramid into the buffers from two frames back.
 #include <gtest/gtest.h>
 
 #include <opencv2/imgcodecs.hpp>
@@ -8,6 +9,7 @@
 #include <string>
 
 #include "alvio/frontend/optical_flow_pyramid.h"
+#include "alvio/frontend/pyramid_history.h"
 #include "test_support.h"
 
 using namespace alvio;
@@ -130,4 +132,37 @@ TEST(OpticalFlowPyramid, RefillsAnOlderPyramidWhereNothingElseHoldsItsBuffers) {
   expectSamePyramid(noise(cv::Size(100, 90), 13), window, 2, std::move(other));
   buildOpticalFlowPyramid8u(next, window, 2, &other);
   expectSamePyramid(next, cv::Size(15, 15), 3, std::move(other));
+}
+
+TEST(PyramidHistory, EachFrameRefillsTheBuffersOfTheOneTwoFramesBack) {
+  const cv::Size window(21, 21);
+  PyramidHistory history;
+  EXPECT_TRUE(history.previous().empty());
+  std::vector<const uchar*> buffers;  // each frame's level-0 image buffer
+  std::vector<cv::Mat> frames;
+  for (int k = 0; k < 4; ++k) {
+    frames.push_back(noise(cv::Size(160, 120), 20 + k));
+    const std::vector<cv::Mat>& current = history.build(frames.back(), window, 2);
+    int levels = -1;
+    const std::vector<cv::Mat> expected = openCvPyramid(frames.back(), window, 2, &levels);
+    ASSERT_EQ(current.size(), expected.size());
+    EXPECT_EQ(cv::norm(current[1], expected[1], cv::NORM_INF), 0.0) << "frame " << k;
+    EXPECT_NE(current[0].data, frames.back().data) << "built into the caller's image";
+    if (k > 0) {
+      // The previous frame's pyramid is intact while this one is built.
+      ASSERT_FALSE(history.previous().empty());
+      EXPECT_EQ(history.previous()[0].data, buffers[k - 1]);
+      EXPECT_EQ(cv::norm(history.previous()[0], frames[k - 1], cv::NORM_INF), 0.0);
+    }
+    if (k > 1) EXPECT_EQ(current[0].data, buffers[k - 2]) << "frame " << k;
+    buffers.push_back(current[0].data);
+    history.advance();
+  }
+  history.forgetPrevious();
+  EXPECT_TRUE(history.previous().empty());
+  // Without a previous pyramid the next one is still built, and is the previous after that.
+  history.build(frames[0], window, 2);
+  history.advance();
+  ASSERT_FALSE(history.previous().empty());
+  EXPECT_EQ(cv::norm(history.previous()[0], frames[0], cv::NORM_INF), 0.0);
 }

@@ -6,7 +6,6 @@
 #include <unordered_map>
 
 #include "alvio/common/error.h"
-#include "alvio/frontend/optical_flow_pyramid.h"
 #include "alvio/frontend/pyramidal_klt.h"
 #include "alvio/frontend/rotated_pixels.h"
 
@@ -20,7 +19,7 @@ PointTracker::PointTracker(const PointTrackerOptions& options,
       anchors_(options.anchors) {}
 
 void PointTracker::reset() {
-  prev_pyramid_.clear();
+  pyramids_.forgetPrevious();
   pts_.clear();
   ids_.clear();
   track_counts_.clear();
@@ -136,11 +135,10 @@ FeatureFrame PointTracker::track(const cv::Mat& gray, int64_t t_ns, FrameTiming*
     const cv::Size win(options_.klt_window, options_.klt_window);
     // The image's pyramid and gradients, built once: the forward pass needs the previous
     // frame's, the backward pass this frame's, and this frame's serve the next frame again
-    // (calcOpticalFlowPyrLK on plain images would build them four times a frame). Built into
-    // the buffers of the pyramid from two frames back; never into the caller's image.
-    std::vector<cv::Mat> pyramid = std::move(spare_pyramid_);
-    buildOpticalFlowPyramid8u(img, win, options_.klt_levels, &pyramid);
-    if (!prev_pyramid_.empty() && !pts_.empty()) {
+    // (calcOpticalFlowPyrLK on plain images would build them four times a frame).
+    const std::vector<cv::Mat>& pyramid = pyramids_.build(img, win, options_.klt_levels);
+    const std::vector<cv::Mat>& prev_pyramid = pyramids_.previous();
+    if (!prev_pyramid.empty() && !pts_.empty()) {
       std::vector<cv::Point2f> next;
       std::vector<uchar> status;
       // Started where the gyroscope's rotation puts them, corners need fewer levels. Those
@@ -154,7 +152,7 @@ FeatureFrame PointTracker::track(const cv::Mat& gray, int64_t t_ns, FrameTiming*
       } else if (predicted) {
         const std::vector<cv::Point2f> predictions = rotated(*R_cur_prev, pts_);
         next = predictions;
-        flowForwardBackward(prev_pyramid_, pyramid, pts_, &next, &status, options_.gyro_klt_levels,
+        flowForwardBackward(prev_pyramid, pyramid, pts_, &next, &status, options_.gyro_klt_levels,
                             &*R_cur_prev);
         std::vector<std::size_t> failed;
         std::vector<cv::Point2f> from, to;
@@ -166,7 +164,7 @@ FeatureFrame PointTracker::track(const cv::Mat& gray, int64_t t_ns, FrameTiming*
           }
         if (!failed.empty() && options_.gyro_klt_levels < options_.klt_levels) {
           std::vector<uchar> again;
-          flowForwardBackward(prev_pyramid_, pyramid, from, &to, &again, options_.klt_levels,
+          flowForwardBackward(prev_pyramid, pyramid, from, &to, &again, options_.klt_levels,
                               &*R_cur_prev);
           for (std::size_t k = 0; k < failed.size(); ++k) {
             next[failed[k]] = to[k];
@@ -174,7 +172,7 @@ FeatureFrame PointTracker::track(const cv::Mat& gray, int64_t t_ns, FrameTiming*
           }
         }
       } else {
-        flowForwardBackward(prev_pyramid_, pyramid, pts_, &next, &status, options_.klt_levels);
+        flowForwardBackward(prev_pyramid, pyramid, pts_, &next, &status, options_.klt_levels);
       }
       if (!aligned_first) {
         for (std::size_t i = 0; i < status.size(); ++i)
@@ -187,8 +185,7 @@ FeatureFrame PointTracker::track(const cv::Mat& gray, int64_t t_ns, FrameTiming*
       ids_.clear();
       track_counts_.clear();
     }
-    spare_pyramid_ = std::move(prev_pyramid_);
-    prev_pyramid_ = std::move(pyramid);
+    pyramids_.advance();
     for (int& c : track_counts_) ++c;
   }
 
@@ -256,7 +253,7 @@ void PointTracker::retakePatch(int id, const cv::Mat& img, const cv::Point2f& p,
 void PointTracker::trackAlignedFirst(const std::vector<cv::Mat>& pyramid, const cv::Mat& img) {
   std::vector<cv::Point2f> next;
   std::vector<uchar> status;
-  flow(prev_pyramid_, pyramid, pts_, &next, &status, options_.klt_levels);
+  flow(pyramids_.previous(), pyramid, pts_, &next, &status, options_.klt_levels);
   anchors_.tick();
   std::vector<Alignment> alignment(pts_.size(), Alignment::kOutside);
   std::vector<std::size_t> unchecked;
@@ -279,7 +276,7 @@ void PointTracker::trackAlignedFirst(const std::vector<cv::Mat>& pyramid, const 
   }
   if (!unchecked.empty()) {
     const std::vector<uchar> back =
-        returns(prev_pyramid_, pyramid, arrivals, origins, origins, options_.klt_levels);
+        returns(pyramids_.previous(), pyramid, arrivals, origins, origins, options_.klt_levels);
     for (std::size_t k = 0; k < unchecked.size(); ++k)
       if (!back[k]) status[unchecked[k]] = 0;
   }

@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include "alvio/frontend/optical_flow_pyramid.h"
 #include "alvio/frontend/pyramidal_klt.h"
 #include "alvio/frontend/rotated_pixels.h"
 
@@ -154,7 +153,7 @@ void OpticalFlowLineTracker::predict(const std::vector<cv::Mat>& pyramid, cv::Si
   }
   std::vector<cv::Point2f> moved;
   std::vector<uchar> status;
-  trackPyramidalKlt(prev_pyramid_, pyramid, samples, &moved, &status, kltWindow(),
+  trackPyramidalKlt(pyramids_.previous(), pyramid, samples, &moved, &status, kltWindow(),
                     options_.flow.klt_pyramid_levels, kltStop(), false);
   for (std::size_t i = 0; i < moved.size(); ++i)
     status[i] = status[i] && !windowOutside(moved[i], image_size);
@@ -182,7 +181,7 @@ void OpticalFlowLineTracker::predictFromRotation(const std::vector<cv::Mat>& pyr
       });
   std::vector<cv::Point2f> moved = predicted;
   std::vector<uchar> status;
-  trackPyramidalKlt(prev_pyramid_, pyramid, samples, &moved, &status, kltWindow(),
+  trackPyramidalKlt(pyramids_.previous(), pyramid, samples, &moved, &status, kltWindow(),
                     f.gyro_klt_levels, kltStop(), true);
   for (std::size_t i = 0; i < moved.size(); ++i)
     status[i] = status[i] && !windowOutside(moved[i], image_size);
@@ -203,8 +202,8 @@ void OpticalFlowLineTracker::predictFromRotation(const std::vector<cv::Mat>& pyr
       to.push_back(predicted[t * n + k]);
     }
   std::vector<uchar> again;
-  trackPyramidalKlt(prev_pyramid_, pyramid, from, &to, &again, kltWindow(), f.klt_pyramid_levels,
-                    kltStop(), true);
+  trackPyramidalKlt(pyramids_.previous(), pyramid, from, &to, &again, kltWindow(),
+                    f.klt_pyramid_levels, kltStop(), true);
   for (std::size_t j = 0; j < again_lines.size(); ++j) {
     const std::size_t t = again_lines[j];
     for (std::size_t k = 0; k < n; ++k) {
@@ -260,11 +259,9 @@ void OpticalFlowLineTracker::associate(const cv::Mat& undistorted,
                                        const std::vector<LineSegment>& detections, bool detected,
                                        LineFrame* frame) {
   const auto& f = options_.flow;
-  // Built once per frame and kept as the next frame's previous pyramid, into the buffers of
-  // the one from two frames back. Never the caller's buffer: it may be overwritten after we
-  // return.
-  std::vector<cv::Mat> pyramid = std::move(spare_pyramid_);
-  buildOpticalFlowPyramid8u(undistorted, kltWindow(), f.klt_pyramid_levels, &pyramid);
+  // Built once per frame and kept as the next frame's previous pyramid.
+  const std::vector<cv::Mat>& pyramid =
+      pyramids_.build(undistorted, kltWindow(), f.klt_pyramid_levels);
   predict(pyramid, undistorted.size());
   std::vector<Track> next = detected ? match(detections, frame) : carryPredictions(frame);
 
@@ -278,8 +275,7 @@ void OpticalFlowLineTracker::associate(const cv::Mat& undistorted,
     frame->lines.push_back(obs);
   }
   tracks_ = std::move(next);
-  spare_pyramid_ = std::move(prev_pyramid_);
-  prev_pyramid_ = std::move(pyramid);
+  pyramids_.advance();
 }
 
 std::vector<OpticalFlowLineTracker::Track> OpticalFlowLineTracker::carryPredictions(

@@ -17,6 +17,7 @@
 #include "alvio/frontend/feature_frame.h"
 #include "alvio/frontend/patch_anchors.h"
 #include "alvio/frontend/point_tracker_options.h"
+#include "alvio/frontend/pyramid_history.h"
 
 namespace alvio {
 
@@ -80,8 +81,7 @@ class PointTracker {
   Clahe clahe_;
   CornerDetector corners_;
   PatchAnchors anchors_;
-  std::vector<cv::Mat> prev_pyramid_;   // with gradients, for KLT
-  std::vector<cv::Mat> spare_pyramid_;  // the one before, whose buffers the next frame refills
+  PyramidHistory pyramids_;  // with gradients, for KLT
   int64_t prev_t_ns_ = 0;
   std::vector<cv::Point2f> pts_;
   std::vector<int> ids_, track_counts_;

@@ -23,6 +23,7 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
+#include "alvio/frontend/pyramid_history.h"
 #include "alvio/lines/line_tracker.h"
 
 namespace alvio {
@@ -72,8 +73,7 @@ class OpticalFlowLineTracker final : public LineTracker {
                   Prediction* prediction) const;
 
   std::vector<Track> tracks_;
-  std::vector<cv::Mat> prev_pyramid_;
-  std::vector<cv::Mat> spare_pyramid_;  // the one before, whose buffers the next frame refills
+  PyramidHistory pyramids_;  // with gradients, for KLT
   std::vector<Prediction> predictions_;
   int frames_since_detection_ = 0;
 };
