@@ -1,7 +1,8 @@
 // alvio_micro_bench: Google Benchmark micro-benchmarks of the hot paths: line detection and
-// tracking, point tracking and corner detection on a fixed frame pair, IMU preintegration,
-// factor evaluation and one estimator step (window optimisation) on a synthetic scenario. Built by
-// ./alvio build, never run in CI (timings on shared machines are for people, not for assertions).
+// tracking, point tracking, corner detection, CLAHE and the undistortion on a fixed frame pair,
+// IMU preintegration, factor evaluation and one estimator step (window optimisation) on a
+// synthetic scenario. Built by ./alvio build, never run in CI (timings on shared machines are
+// for people, not for assertions).
 //
 //   alvio_micro_bench [--benchmark_filter=Line] [google benchmark flags]
 //
@@ -25,6 +26,7 @@
 #include "alvio/estimator/estimator.h"
 #include "alvio/estimator/factors/imu_factor.h"
 #include "alvio/estimator/factors/point_projection_factor.h"
+#include "alvio/frontend/clahe.h"
 #include "alvio/frontend/corner_detector.h"
 #include "alvio/frontend/gyro_rotation.h"
 #include "alvio/frontend/min_eigen_response.h"
@@ -34,6 +36,7 @@
 #include "alvio/geometry/line_projection_factor.h"
 #include "alvio/imu/imu_preintegration.h"
 #include "alvio/io/euroc_dataset.h"
+#include "alvio/lines/image_undistorter.h"
 #include "alvio/lines/line_detector.h"
 #include "alvio/lines/line_tracker.h"
 #include "synthetic_scenario.h"
@@ -304,6 +307,20 @@ void BM_CornerResponse(benchmark::State& state) {
   for (auto _ : state) calculator.compute(image, &response);
 }
 BENCHMARK(BM_CornerResponse)->Unit(benchmark::kMillisecond);
+
+// Each frame's preprocessing: CLAHE for the point tracker, the undistortion for the lines.
+void BM_Clahe(benchmark::State& state) {
+  const PointTrackerOptions& o = config().points;
+  Clahe clahe(o.clahe_clip_limit, o.clahe_tiles);
+  cv::Mat out;
+  for (auto _ : state) clahe.apply(framePair().a, out);
+}
+BENCHMARK(BM_Clahe)->Unit(benchmark::kMillisecond);
+void BM_Undistortion(benchmark::State& state) {
+  const ImageUndistorter undistorter(config().camera);
+  for (auto _ : state) benchmark::DoNotOptimize(undistorter.undistort(framePair().a).data);
+}
+BENCHMARK(BM_Undistortion)->Unit(benchmark::kMillisecond);
 
 // One frame interval of IMU at 200 Hz (10 midpoint steps with covariance propagation).
 void BM_ImuPreintegration(benchmark::State& state) {
