@@ -141,14 +141,22 @@ TEST(ImuFactor, AnalyticJacobiansMatchNumeric) {
   }
 }
 
+// Three poses and the inverse depth of a point anchored in the first, seen from the others.
+struct ThreeViews {
+  ThreeViews() {
+    setPose(pose0, Eigen::Vector3d(0, 0, 0), Eigen::Quaterniond::Identity());
+    setPose(pose1, Eigen::Vector3d(0.2, 0.1, 0), expQuaternion(Eigen::Vector3d(0.02, 0.05, 0.01)));
+    setPose(pose2, Eigen::Vector3d(0.4, 0.1, 0.1), expQuaternion(Eigen::Vector3d(0.03, 0.1, 0.0)));
+  }
+  double pose0[7], pose1[7], pose2[7], inv_depth[1] = {0.25};
+};
+
 // A prior built from factors must reproduce their cost to second order for the kept
 // states, once the dropped states are optimised out.
 TEST(Marginalization, PriorJacobiansMatchNumericAndKeepsInformation) {
   const Eigen::Isometry3d T_b_c = eurocTbc();
-  double pose0[7], pose1[7], pose2[7], inv_depth[1] = {0.25};
-  setPose(pose0, Eigen::Vector3d(0, 0, 0), Eigen::Quaterniond::Identity());
-  setPose(pose1, Eigen::Vector3d(0.2, 0.1, 0), expQuaternion(Eigen::Vector3d(0.02, 0.05, 0.01)));
-  setPose(pose2, Eigen::Vector3d(0.4, 0.1, 0.1), expQuaternion(Eigen::Vector3d(0.03, 0.1, 0.0)));
+  ThreeViews views;
+  auto& [pose0, pose1, pose2, inv_depth] = views;
   auto info = std::make_shared<MarginalizationInfo>();
   // pose0 and the point are dropped; pose1 and pose2 are kept.
   info->addResidualBlock(new PointProjectionFactor({0.1, 0.05}, {0.05, 0.06}, T_b_c, 100.0),
@@ -173,10 +181,8 @@ TEST(Marginalization, PriorJacobiansMatchNumericAndKeepsInformation) {
 // The prior must not care about the sign of a quaternion parameter.
 TEST(Marginalization, PriorIgnoresQuaternionSign) {
   const Eigen::Isometry3d T_b_c = eurocTbc();
-  double pose0[7], pose1[7], pose2[7], inv_depth[1] = {0.25};
-  setPose(pose0, Eigen::Vector3d(0, 0, 0), Eigen::Quaterniond::Identity());
-  setPose(pose1, Eigen::Vector3d(0.2, 0.1, 0), expQuaternion(Eigen::Vector3d(0.02, 0.05, 0.01)));
-  setPose(pose2, Eigen::Vector3d(0.4, 0.1, 0.1), expQuaternion(Eigen::Vector3d(0.03, 0.1, 0.0)));
+  ThreeViews views;
+  auto& [pose0, pose1, pose2, inv_depth] = views;
   auto info = std::make_shared<MarginalizationInfo>();
   info->addResidualBlock(new PointProjectionFactor({0.1, 0.05}, {0.05, 0.06}, T_b_c, 100.0),
                          nullptr, {pose0, pose1, inv_depth}, {0, 2});
