@@ -357,10 +357,6 @@ def ratio(a, b):
     return None if a is None or b is None or a == 0 else b / a
 
 
-def median_frame_ms(run):
-    return (run.get("timing") or {}).get("total", {}).get("median")
-
-
 def paired_ratios(per_run, seq, a, b, value=lambda r: r.get("ate")):
     """B/A ratios of `value` (ATE unless given) of the runs that share sequence, seed and
     repeat, in seed and repeat order: the order they ran in."""
@@ -411,7 +407,7 @@ def paired_time_line(per_run, a, b):
     them, so each two consecutive pairs' ratios are combined (their geometric mean) before
     pooling: a constant difference between the cores then cancels."""
     ratios = [x for seq in dict.fromkeys(r["sequence"] for r in per_run)
-              for x in paired_ratios(per_run, seq, a, b, median_frame_ms)]
+              for x in paired_ratios(per_run, seq, a, b, lambda r: stage(r, "total"))]
     blocks = [math.sqrt(x * y) for x, y in zip(ratios[0::2], ratios[1::2])
               if x is not None and y is not None and x > 0 and y > 0]
     pooled = pooled_ratio(blocks)
