@@ -1,10 +1,10 @@
 #pragma once
 // The KLT image pyramid with gradients, as alvio's trackers build it, bit for bit
 // cv::buildOpticalFlowPyramid's and faster. OpenCV computes each level's Scharr gradients with
-// 128-bit vectors into the level's centre and then fills their border in a second pass. Here
-// the gradients are computed with the widest vectors the CPU has (chosen when the library
-// loads) and the border is written in the same pass. Integer arithmetic throughout, so the
-// result does not depend on the instructions used.
+// 128-bit vectors into the level's centre and then copies the whole level again to add their
+// border. Here the gradients are computed with the widest vectors the CPU has (chosen when the
+// library loads) and only the border is written afterwards, zeroed. Integer arithmetic
+// throughout, so the result does not depend on the instructions used.
 
 #include <opencv2/core.hpp>
 #include <vector>
