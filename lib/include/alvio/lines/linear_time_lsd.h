@@ -12,7 +12,10 @@
 // test_line_detector compares the two.
 
 #include <opencv2/core.hpp>
+#include <optional>
 #include <vector>
+
+#include "alvio/frontend/gaussian_blur_8u.h"
 
 namespace alvio {
 
@@ -56,8 +59,9 @@ class LinearTimeLsd {
   /// extreme projections on that axis, as a segment in scaled-image pixels.
   cv::Vec4d regionToSegment(double region_angle) const;
 
-  double scale_, sigma_scale_, threshold_;
+  double scale_, threshold_;
   bool pyramid_downscale_;
+  std::optional<GaussianBlur8u> blur_;  // OpenCV's blur before the scaling, bit for bit
   cv::Mat blurred_, scaled_;
   int width_ = 0, height_ = 0;
   // Per pixel, defined where used_ is 0 after computeGradient.
@@ -65,6 +69,7 @@ class LinearTimeLsd {
   std::vector<float> gradient_;  // gradient norm
   std::vector<uint8_t> used_;    // taken by a region, or without a direction
   std::vector<int> candidates_;  // pixels with a direction, in raster order
+  std::vector<uint8_t> strong_;  // one row's: 1 where the gradient is above the threshold
   std::vector<int> seed_bin_;    // each candidate's gradient bin
   float max_gradient_ = 0.0f;
   static constexpr int kTableRadius = 63, kTableSide = 2 * kTableRadius + 1;
