@@ -303,7 +303,9 @@ void PointTracker::detectNew(const cv::Mat& img) {
   std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
     return track_counts_[a] > track_counts_[b];
   });
-  cv::Mat mask(img.size(), CV_8UC1, cv::Scalar(255));
+  detection_mask_.create(img.size(), CV_8UC1);
+  detection_mask_.setTo(255);
+  cv::Mat& mask = detection_mask_;
   std::vector<cv::Point2f> pts;
   std::vector<int> ids, counts;
   for (std::size_t i : order) {

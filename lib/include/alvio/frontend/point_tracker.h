@@ -82,6 +82,7 @@ class PointTracker {
   CornerDetector corners_;
   PatchAnchors anchors_;
   PyramidHistory pyramids_;  // with gradients, for KLT
+  cv::Mat detection_mask_;   // kept between frames: a new one would be paged in every frame
   int64_t prev_t_ns_ = 0;
   std::vector<cv::Point2f> pts_;
   std::vector<int> ids_, track_counts_;
