@@ -177,6 +177,12 @@ void Estimator::optimize(FrameTiming* timing, int max_iterations) {
   statesToParameters();
   ceres::Problem::Options problem_options;
   problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+#ifdef NDEBUG
+  // Ceres' checks (no block passed twice to a residual, none overlapping another) sort and
+  // look up every residual's blocks on each solve. The window's blocks are separate fixed
+  // arrays; builds without NDEBUG still check them.
+  problem_options.disable_all_safety_checks = true;
+#endif
   ceres::Problem problem(problem_options);
   // Landmarks are eliminated first, states form the reduced system. Left to itself Ceres also
   // eliminates every other speed-bias block, whose 15-row IMU residuals then force its slowest
@@ -244,6 +250,8 @@ void Estimator::optimize(FrameTiming* timing, int max_iterations) {
   options.trust_region_strategy_type = ceres::DOGLEG;
   options.max_num_iterations = max_iterations;
   options.num_threads = options_.num_threads;
+  // Ceres formats a log line every iteration unless silent, even when nothing prints it.
+  options.logging_type = ceres::SILENT;
   ceres::Solver::Summary summary;
   ceres::Solve(options, &problem, &summary);
   stats_.iterations = static_cast<int>(summary.iterations.size());

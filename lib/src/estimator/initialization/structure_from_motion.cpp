@@ -259,6 +259,7 @@ bool reconstructStructure(int num_frames, int ref, const Eigen::Matrix3d& R_ref_
   ceres::Solver::Options options;
   options.linear_solver_type = ceres::DENSE_SCHUR;
   options.max_num_iterations = 30;
+  options.logging_type = ceres::SILENT;  // no per-iteration log line formatted for nothing
   ceres::Solver::Summary summary;
   ceres::Solve(options, &problem, &summary);
   if (summary.termination_type != ceres::CONVERGENCE && summary.final_cost > 5e-3) {
