@@ -1,7 +1,6 @@
 #include "alvio/lines/edge_refinement.h"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <vector>
 
@@ -37,7 +36,9 @@ bool refineSegmentToEdge(const cv::Mat& image, const EdgeRefinementOptions& opti
       std::clamp(static_cast<int>(length / options.sample_spacing_px), 2, options.max_samples);
 
   std::vector<Eigen::Vector2d> base;
-  std::vector<std::array<double, kMaxProfile>> derivs;
+  std::vector<double> derivs;  // n_deriv per sample in base
+  base.reserve(samples);
+  derivs.reserve(std::size_t(samples) * n_deriv);
   double polarity_sum = 0;
   for (int s = 0; s < samples; ++s) {
     const Eigen::Vector2d p = segment->pointAt(length * (s + 0.5) / samples);
@@ -45,20 +46,20 @@ bool refineSegmentToEdge(const cv::Mat& image, const EdgeRefinementOptions& opti
     if (std::min({lo.x(), lo.y(), hi.x(), hi.y()}) < 0 ||
         std::max(lo.x(), hi.x()) > image.cols - 2 || std::max(lo.y(), hi.y()) > image.rows - 2)
       continue;
-    std::array<double, kMaxProfile> intensity{}, d{};
+    double intensity[kMaxProfile];
     for (int k = 0; k <= n_deriv; ++k)
       intensity[k] = intensityAt(image, p + ((k - half - 0.5) * kStepPx) * normal);
-    for (int k = 0; k < n_deriv; ++k) d[k] = (intensity[k + 1] - intensity[k]) / kStepPx;
-    polarity_sum += d[half];
+    for (int k = 0; k < n_deriv; ++k) derivs.push_back((intensity[k + 1] - intensity[k]) / kStepPx);
+    polarity_sum += derivs[derivs.size() - n_deriv + half];
     base.push_back(p);
-    derivs.push_back(d);
   }
   if (base.size() < 3) return false;
   const double polarity = polarity_sum >= 0 ? 1.0 : -1.0;
 
   std::vector<Eigen::Vector2d> peaks;
+  peaks.reserve(base.size());
   for (std::size_t s = 0; s < base.size(); ++s) {
-    const auto& d = derivs[s];
+    const double* d = &derivs[s * n_deriv];
     int best = -1;
     for (int k = 1; k + 1 < n_deriv; ++k)
       if (polarity * d[k] >= options.min_contrast &&
