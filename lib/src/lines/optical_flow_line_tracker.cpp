@@ -71,6 +71,9 @@ bool OpticalFlowLineTracker::predictOne(const Track& track, const std::vector<cv
   std::vector<double> along_prev;
   std::vector<int> sample;  // index k of each kept point: 0 and n - 1 are the endpoints
   std::vector<Eigen::Vector2d> points;
+  along_prev.reserve(n);
+  sample.reserve(n);
+  points.reserve(n);
   // Samples within half a KLT window of the border are tracked with a truncated window and
   // drift; an endpoint that the border cut off is not a point of the scene either.
   const double margin = 0.5 * options_.flow.klt_window_px;
