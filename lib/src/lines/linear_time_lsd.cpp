@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <opencv2/imgproc.hpp>
 
 #include "alvio/common/widest_vectors.h"
@@ -15,6 +16,7 @@ constexpr double kTolerance = CV_PI * kAngleToleranceDeg / 180.0;
 constexpr double kAlignedProbability = kAngleToleranceDeg / 180.0;
 constexpr int kGradientBins = 1024;
 constexpr double kDegToRad = CV_PI / 180.0;
+constexpr float kNotComputed = std::numeric_limits<float>::quiet_NaN();
 }  // namespace
 
 LinearTimeLsd::LinearTimeLsd(double scale, double sigma_scale, double quant, bool pyramid_downscale)
@@ -80,7 +82,12 @@ void LinearTimeLsd::detect(const cv::Mat& gray, std::vector<cv::Vec4f>* segments
 
 LinearTimeLsd::Direction LinearTimeLsd::direction(float angle) {
   // In float, as the region's running sum adds them.
-  return {angle, {std::cos(angle), std::sin(angle)}};
+  return {angle, {std::cos(angle), std::sin(angle)}, seedCosSin(angle)};
+}
+
+LinearTimeLsd::CosSin LinearTimeLsd::seedCosSin(float angle) {
+  const double a = angle;
+  return {static_cast<float>(std::cos(a)), static_cast<float>(std::sin(a))};
 }
 
 float LinearTimeLsd::levelLineAngle(int gx, int gy) {
@@ -112,6 +119,7 @@ void LinearTimeLsd::computeGradient() {
   angle_.resize(n);
   gradient_.resize(n);
   cos_sin_.resize(n);
+  seed_cos_sin_.resize(n);
   candidates_.resize(n);
   strong_.resize(width_);
   std::size_t count = 0;
@@ -142,12 +150,16 @@ void LinearTimeLsd::computeGradient() {
       const float g = static_cast<float>(std::sqrt(norm2 / 4.0));
       gradient_[offset + x] = g;
       max_gradient_ = std::max(max_gradient_, g);
-      const Direction d =
-          std::abs(gx) <= kTableRadius && std::abs(gy) <= kTableRadius
-              ? direction_table_[(gy + kTableRadius) * kTableSide + gx + kTableRadius]
-              : direction(levelLineAngle(gx, gy));
+      Direction d;
+      if (std::abs(gx) <= kTableRadius && std::abs(gy) <= kTableRadius) {
+        d = direction_table_[(gy + kTableRadius) * kTableSide + gx + kTableRadius];
+      } else {
+        const float a = levelLineAngle(gx, gy);
+        d = {a, {std::cos(a), std::sin(a)}, {kNotComputed, kNotComputed}};
+      }
       angle_[offset + x] = d.angle;
       cos_sin_[offset + x] = d.cos_sin;
+      seed_cos_sin_[offset + x] = d.seed;
       used_[offset + x] = 0;
     }
   }
@@ -185,8 +197,10 @@ double LinearTimeLsd::growRegion(int seed) {
   used[seed] = 1;
   double region_angle = angle[seed];
   region_.push_back({seed % width, seed / width, angle[seed], gradient[seed]});
-  float sum_dx = static_cast<float>(std::cos(region_angle));
-  float sum_dy = static_cast<float>(std::sin(region_angle));
+  CosSin start = seed_cos_sin_[seed];
+  if (std::isnan(start.cos)) start = seedCosSin(angle[seed]);
+  float sum_dx = start.cos;
+  float sum_dy = start.sin;
   auto visit = [&](int k, int x, int y) {
     if (used[k]) return;
     // Within the tolerance of the region's direction, modulo 2 pi.

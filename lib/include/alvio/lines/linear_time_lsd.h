@@ -44,12 +44,15 @@ class LinearTimeLsd {
   struct Direction {
     float angle;
     CosSin cos_sin;
+    CosSin seed;  ///< the cosine and sine in double, rounded to float: a region's first term
   };
 
   /// The level-line angle [rad] of the 2x2 gradient (gx, gy): the gradient turned by 90 deg.
   static float levelLineAngle(int gx, int gy);
-  /// The angle with its cosine and sine in float, as region growth sums them.
+  /// The angle with its cosine and sine in float, as region growth sums them, and in double
+  /// (rounded to float), as a region starts from its seed's.
   static Direction direction(float angle);
+  static CosSin seedCosSin(float angle);
   void computeGradient();
   void orderSeeds();
   /// Grows the region of pixels aligned with the seed's running mean direction (8-connected).
@@ -75,7 +78,10 @@ class LinearTimeLsd {
   static constexpr int kTableRadius = 63, kTableSide = 2 * kTableRadius + 1;
   std::vector<Direction> direction_table_;  // for |gx|, |gy| <= kTableRadius
   std::vector<CosSin> cos_sin_;             // of angle_
-  std::vector<int> seeds_;                  // pixel indices, strongest gradient bin first
+  // Direction::seed of angle_, from the table; NaN where the gradient lies outside it (only
+  // the pixels that start a region need it, and glibc's double sincos is slow).
+  std::vector<CosSin> seed_cos_sin_;
+  std::vector<int> seeds_;  // pixel indices, strongest gradient bin first
   std::vector<int> bin_count_;
   std::vector<RegionPixel> region_;
 };
