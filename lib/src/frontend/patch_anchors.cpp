@@ -57,28 +57,33 @@ int PatchAnchors::warpParameters(const std::string& warp) {
 bool PatchAnchors::anchor(int id, const cv::Mat& image, const cv::Point2f& p) {
   const int n = options_.window, m = n + 2, h = n / 2;  // one more pixel each side: gradients
   const bool affine = k_params_ == 6;
-  std::vector<float> big(m * m);
+  std::vector<float>& big = scratch_big_;
+  big.resize(m * m);
   if (!samplePatch(image, p, m, big.data())) return false;
   Patch patch;
-  patch.values.resize(n * n);
-  for (int i = 0; i < k_params_; ++i) patch.sd[i].resize(n * n);
+  // The warps keep only the packed blocks: the values and sd are then worked out in buffers
+  // kept from call to call.
+  std::vector<float>& values = k_params_ > 2 ? scratch_values_ : patch.values;
+  std::array<std::vector<float>, 6>& sd = k_params_ > 2 ? scratch_sd_ : patch.sd;
+  values.resize(n * n);
+  for (int i = 0; i < k_params_; ++i) sd[i].resize(n * n);
   double sum = 0;
   for (int r = 0; r < n; ++r)
     for (int c = 0; c < n; ++c) {
       const int k = r * n + c, b = (r + 1) * m + (c + 1);
       const float gx = 0.5f * (big[b + 1] - big[b - 1]), gy = 0.5f * (big[b + m] - big[b - m]);
       const float x = static_cast<float>(c - h), y = static_cast<float>(r - h);
-      patch.values[k] = big[b];
-      patch.sd[0][k] = gx;
-      patch.sd[1][k] = gy;
+      values[k] = big[b];
+      sd[0][k] = gx;
+      sd[1][k] = gy;
       if (k_params_ == 4) {
-        patch.sd[2][k] = gx * x + gy * y;   // scale
-        patch.sd[3][k] = -gx * y + gy * x;  // rotation
-      } else if (affine) {                  // A = I + [p2 p3; p4 p5]
-        patch.sd[2][k] = gx * x;
-        patch.sd[3][k] = gx * y;
-        patch.sd[4][k] = gy * x;
-        patch.sd[5][k] = gy * y;
+        sd[2][k] = gx * x + gy * y;   // scale
+        sd[3][k] = -gx * y + gy * x;  // rotation
+      } else if (affine) {            // A = I + [p2 p3; p4 p5]
+        sd[2][k] = gx * x;
+        sd[3][k] = gx * y;
+        sd[4][k] = gy * x;
+        sd[5][k] = gy * y;
       }
       sum += big[b];
     }
@@ -94,13 +99,13 @@ bool PatchAnchors::anchor(int id, const cv::Mat& image, const cv::Point2f& p) {
   const auto accumulate = [&](auto parameters) {
     constexpr int K = decltype(parameters)::value;
     for (int k = 0; k < n * n; ++k) {
-      patch.values[k] -= mean;
-      ss += patch.values[k] * patch.values[k];
+      values[k] -= mean;
+      ss += values[k] * values[k];
       Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
-      for (int i = 0; i < K; ++i) g[i] = patch.sd[i][k];
+      for (int i = 0; i < K; ++i) g[i] = sd[i][k];
       addOuterUpper<K>(g.data(), upper);
       patch.sum_sd += g;
-      patch.sum_sd_t += g * patch.values[k];
+      patch.sum_sd_t += g * values[k];
     }
   };
   if (k_params_ == 6)
@@ -128,16 +133,16 @@ bool PatchAnchors::anchor(int id, const cv::Mat& image, const cv::Point2f& p) {
   }
   patch.norm = static_cast<float>(std::sqrt(ss));
   if (k_params_ > 2) {
+    // A track's new patch takes its old patch's buffer.
+    if (const auto it = patches_.find(id); it != patches_.end())
+      patch.packed.swap(it->second.packed);
     patch.packed.assign(std::size_t(n) * n * 8, 0.0f);
     for (int k = 0; k < n * n; ++k) {
       float* block = &patch.packed[std::size_t(k) * 8];
       block[0] = 1.0f;
-      block[1] = patch.values[k];
-      for (int i = 0; i < k_params_; ++i) block[2 + i] = patch.sd[i][k];
+      block[1] = values[k];
+      for (int i = 0; i < k_params_; ++i) block[2 + i] = sd[i][k];
     }
-    // The warps read only the packed blocks: not two copies of the same template.
-    patch.values = {};
-    patch.sd = {};
   }
   patches_[id] = std::move(patch);
   return true;

@@ -99,6 +99,9 @@ class PatchAnchors {
   PatchAnchorOptions options_;
   int k_params_;
   std::unordered_map<int, Patch> patches_;
+  // anchor()'s working buffers, kept so that each new patch does not allocate them again.
+  std::vector<float> scratch_big_, scratch_values_;
+  std::array<std::vector<float>, 6> scratch_sd_;
 };
 
 }  // namespace alvio
