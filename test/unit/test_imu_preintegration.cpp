@@ -118,3 +118,27 @@ TEST(ImuPreintegration, CovarianceMatchesMonteCarlo) {
   // Compare the variances (diagonal): within 15 % (Monte-Carlo error with 3000 trials ~3 %).
   for (int i = 0; i < 9; ++i) EXPECT_NEAR(cov(i, i) / predicted(i, i), 1.0, 0.15) << "state " << i;
 }
+
+// The cached square root of the information follows every change of the covariance.
+TEST(ImuPreintegration, SqrtInformationFollowsTheCovariance) {
+  const Eigen::Vector3d acc(0.3, -0.2, 9.81), gyr(0.1, 0.05, -0.2);
+  ImuPreintegration pre(acc, gyr, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), ImuNoise());
+  auto expected = [&] {
+    const ImuPreintegration::Matrix15 info = pre.covariance().inverse();
+    return ImuPreintegration::Matrix15(
+        Eigen::LLT<ImuPreintegration::Matrix15>(0.5 * (info + info.transpose()))
+            .matrixL()
+            .transpose());
+  };
+  for (int i = 0; i < 3; ++i) pre.push(0.005, acc, gyr);
+  const ImuPreintegration::Matrix15 first = pre.sqrtInformation();
+  EXPECT_EQ(first, expected());
+  pre.push(0.005, acc, gyr);
+  EXPECT_NE(pre.sqrtInformation(), first);
+  EXPECT_EQ(pre.sqrtInformation(), expected());
+  const ImuPreintegration::Matrix15 before = pre.sqrtInformation();
+  pre.repropagate(Eigen::Vector3d(0.1, 0, 0), Eigen::Vector3d(0, 0.01, 0));
+  // New biases turn the integrated rotations, and so the covariance.
+  EXPECT_NE(pre.sqrtInformation(), before);
+  EXPECT_EQ(pre.sqrtInformation(), expected());
+}

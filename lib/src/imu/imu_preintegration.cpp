@@ -1,5 +1,8 @@
 #include "alvio/imu/imu_preintegration.h"
 
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+
 #include "alvio/common/rotation.h"
 
 namespace alvio {
@@ -34,6 +37,15 @@ void ImuPreintegration::repropagate(const Eigen::Vector3d& ba, const Eigen::Vect
   jacobian_.setIdentity();
   covariance_.setZero();
   for (std::size_t i = 0; i < dts_.size(); ++i) integrate(dts_[i], accs_[i], gyrs_[i]);
+}
+
+const ImuPreintegration::Matrix15& ImuPreintegration::sqrtInformation() const {
+  if (sqrt_information_stale_) {
+    const Matrix15 info = covariance_.inverse();
+    sqrt_information_ = Eigen::LLT<Matrix15>(0.5 * (info + info.transpose())).matrixL().transpose();
+    sqrt_information_stale_ = false;
+  }
+  return sqrt_information_;
 }
 
 void ImuPreintegration::integrate(double dt, const Eigen::Vector3d& acc1,
@@ -100,6 +112,7 @@ void ImuPreintegration::integrate(double dt, const Eigen::Vector3d& acc1,
 
   jacobian_ = F * jacobian_;
   covariance_ = F * covariance_ * F.transpose() + G * q.asDiagonal() * G.transpose();
+  sqrt_information_stale_ = true;
 
   delta_p_ = p1;
   delta_q_ = q1;

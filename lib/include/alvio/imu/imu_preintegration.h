@@ -56,6 +56,9 @@ class ImuPreintegration {
   const Eigen::Vector3d& linearizedBg() const { return linearized_bg_; }
   const Matrix15& jacobian() const { return jacobian_; }
   const Matrix15& covariance() const { return covariance_; }
+  /// L^T of the covariance's inverse (r^T Info r = |L^T r|^2), as the IMU factor weighs its
+  /// residual; worked out once per covariance, not once per factor built on each solve.
+  const Matrix15& sqrtInformation() const;
   std::size_t sampleCount() const { return dts_.size(); }
   const std::vector<double>& dts() const { return dts_; }
   const std::vector<Eigen::Vector3d>& accs() const { return accs_; }
@@ -74,6 +77,8 @@ class ImuPreintegration {
   Eigen::Vector3d delta_v_ = Eigen::Vector3d::Zero();
   Matrix15 jacobian_ = Matrix15::Identity();
   Matrix15 covariance_ = Matrix15::Zero();
+  mutable Matrix15 sqrt_information_;
+  mutable bool sqrt_information_stale_ = true;  // covariance_ changed since it was worked out
   std::vector<double> dts_;
   std::vector<Eigen::Vector3d> accs_, gyrs_;
 };

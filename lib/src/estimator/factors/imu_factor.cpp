@@ -8,13 +8,7 @@
 namespace alvio {
 
 ImuFactor::ImuFactor(const ImuPreintegration* preintegration, const Eigen::Vector3d& gravity)
-    : pre_(preintegration), gravity_(gravity) {
-  // L^T of the information matrix: r^T Info r = |L^T r|^2.
-  const Eigen::Matrix<double, 15, 15> info = pre_->covariance().inverse();
-  sqrt_information_ = Eigen::LLT<Eigen::Matrix<double, 15, 15>>(0.5 * (info + info.transpose()))
-                          .matrixL()
-                          .transpose();
-}
+    : pre_(preintegration), gravity_(gravity), sqrt_information_(pre_->sqrtInformation()) {}
 
 bool ImuFactor::Evaluate(double const* const* parameters, double* residuals,
                          double** jacobians) const {
