@@ -35,10 +35,13 @@ LinearTimeLsd::LinearTimeLsd(double scale, double sigma_scale, double quant, boo
   // Most gradients are small: their directions are looked up, computed once by the same calls
   // as the others'.
   direction_table_.resize(kTableSide * kTableSide);
+  // The table also holds the seeds' double cosine and sine, which glibc computes slowly.
   for (int gy = -kTableRadius; gy <= kTableRadius; ++gy)
-    for (int gx = -kTableRadius; gx <= kTableRadius; ++gx)
-      direction_table_[(gy + kTableRadius) * kTableSide + gx + kTableRadius] =
-          direction(levelLineAngle(gx, gy));
+    for (int gx = -kTableRadius; gx <= kTableRadius; ++gx) {
+      Direction& d = direction_table_[(gy + kTableRadius) * kTableSide + gx + kTableRadius];
+      d = direction(levelLineAngle(gx, gy));
+      d.seed = seedCosSin(d.angle);
+    }
 }
 
 void LinearTimeLsd::detect(const cv::Mat& gray, std::vector<cv::Vec4f>* segments) {
@@ -81,8 +84,8 @@ void LinearTimeLsd::detect(const cv::Mat& gray, std::vector<cv::Vec4f>* segments
 }
 
 LinearTimeLsd::Direction LinearTimeLsd::direction(float angle) {
-  // In float, as the region's running sum adds them.
-  return {angle, {std::cos(angle), std::sin(angle)}, seedCosSin(angle)};
+  // In float, as the region's running sum adds them; the seed's terms left to growRegion.
+  return {angle, {std::cos(angle), std::sin(angle)}, {kNotComputed, kNotComputed}};
 }
 
 LinearTimeLsd::CosSin LinearTimeLsd::seedCosSin(float angle) {
@@ -150,13 +153,10 @@ void LinearTimeLsd::computeGradient() {
       const float g = static_cast<float>(std::sqrt(norm2 / 4.0));
       gradient_[offset + x] = g;
       max_gradient_ = std::max(max_gradient_, g);
-      Direction d;
-      if (std::abs(gx) <= kTableRadius && std::abs(gy) <= kTableRadius) {
-        d = direction_table_[(gy + kTableRadius) * kTableSide + gx + kTableRadius];
-      } else {
-        const float a = levelLineAngle(gx, gy);
-        d = {a, {std::cos(a), std::sin(a)}, {kNotComputed, kNotComputed}};
-      }
+      const Direction d =
+          std::abs(gx) <= kTableRadius && std::abs(gy) <= kTableRadius
+              ? direction_table_[(gy + kTableRadius) * kTableSide + gx + kTableRadius]
+              : direction(levelLineAngle(gx, gy));
       angle_[offset + x] = d.angle;
       cos_sin_[offset + x] = d.cos_sin;
       seed_cos_sin_[offset + x] = d.seed;

@@ -49,9 +49,10 @@ class LinearTimeLsd {
 
   /// The level-line angle [rad] of the 2x2 gradient (gx, gy): the gradient turned by 90 deg.
   static float levelLineAngle(int gx, int gy);
-  /// The angle with its cosine and sine in float, as region growth sums them, and in double
-  /// (rounded to float), as a region starts from its seed's.
+  /// The angle with its cosine and sine in float, as region growth sums them; `seed` NaN
+  /// (filled in the direction table only).
   static Direction direction(float angle);
+  /// The cosine and sine in double, rounded to float, as a region starts from its seed's.
   static CosSin seedCosSin(float angle);
   void computeGradient();
   void orderSeeds();
