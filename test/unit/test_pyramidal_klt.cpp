@@ -16,12 +16,28 @@ using namespace alvio;
 namespace {
 
 // Blurred noise: texture at several scales, as KLT needs.
-cv::Mat texture(cv::Size size, int seed) {
+cv::Mat texture(cv::Size size, int seed, double blur = 2.0) {
   cv::RNG rng(seed);
   cv::Mat noise(size, CV_8UC1), image;
   rng.fill(noise, cv::RNG::UNIFORM, 0, 256);
-  cv::GaussianBlur(noise, image, cv::Size(0, 0), 2.0);
+  cv::GaussianBlur(noise, image, cv::Size(0, 0), blur);
   cv::normalize(image, image, 0, 255, cv::NORM_MINMAX);
+  return image;
+}
+
+// Black and white squares of random sizes, slightly blurred: steep gradients and large
+// differences, whose products and sums exceed a float's 24 bits, so that the order of KLT's
+// float sums shows in its tracks.
+cv::Mat blocks(cv::Size size, int seed) {
+  cv::RNG rng(seed);
+  cv::Mat image(size, CV_8UC1, cv::Scalar(0));
+  for (int i = 0; i < 600; ++i) {
+    const int side = rng.uniform(4, 24);
+    const cv::Point corner(rng.uniform(0, size.width), rng.uniform(0, size.height));
+    cv::rectangle(image, cv::Rect(corner, cv::Size(side, side)),
+                  cv::Scalar(rng.uniform(0, 2) * 255), cv::FILLED);
+  }
+  cv::GaussianBlur(image, image, cv::Size(0, 0), 0.7);
   return image;
 }
 
@@ -61,7 +77,8 @@ struct Case {
 
 // Points whose position or status differ from OpenCV's (positions compared bit for bit).
 int differingFromOpenCv(const std::vector<cv::Mat>& from, const std::vector<cv::Mat>& to,
-                        const std::vector<cv::Point2f>& points, const Case& c) {
+                        const std::vector<cv::Point2f>& points, const Case& c,
+                        KltVectors vectors = KltVectors::kWidest) {
   std::vector<cv::Point2f> expected, got;
   if (c.initial_flow) {
     for (const cv::Point2f& p : points) expected.push_back(p + cv::Point2f(1.6f, -0.9f));
@@ -70,8 +87,8 @@ int differingFromOpenCv(const std::vector<cv::Mat>& from, const std::vector<cv::
   std::vector<uchar> expected_status, got_status;
   cv::calcOpticalFlowPyrLK(from, to, points, expected, expected_status, cv::noArray(), c.window,
                            c.levels, c.stop, c.initial_flow ? cv::OPTFLOW_USE_INITIAL_FLOW : 0);
-  trackPyramidalKlt(from, to, points, &got, &got_status, c.window, c.levels, c.stop,
-                    c.initial_flow);
+  trackPyramidalKlt(from, to, points, &got, &got_status, c.window, c.levels, c.stop, c.initial_flow,
+                    vectors);
   if (got.size() != expected.size() || got_status.size() != expected_status.size()) return -1;
   int differing = 0;
   for (std::size_t i = 0; i < got.size(); ++i)
@@ -119,12 +136,19 @@ TEST(PyramidalKlt, GivesOpenCvsTracksBitForBit) {
       {{21, 21}, 3, cv::TermCriteria(cv::TermCriteria::COUNT, 5, 0), false},
       {{21, 21}, 2, cv::TermCriteria(cv::TermCriteria::EPS, 0, 0.1), false},
   };
-  for (const Case& c : cases) {
-    const std::vector<cv::Mat> from = pyramidOf(a, c.window, c.levels);
-    const std::vector<cv::Mat> to = pyramidOf(b, c.window, c.levels);
-    EXPECT_EQ(differingFromOpenCv(from, to, points, c), 0)
-        << "window " << c.window << ", levels " << c.levels << ", initial flow " << c.initial_flow;
-  }
+  const cv::Mat c0 = blocks(size, 7);
+  const cv::Mat c1 = shifted(c0, {2.6f, 1.7f});
+  for (const Case& c : cases)
+    for (const bool steep : {false, true}) {
+      const std::vector<cv::Mat> from = pyramidOf(steep ? c0 : a, c.window, c.levels);
+      const std::vector<cv::Mat> to = pyramidOf(steep ? c1 : b, c.window, c.levels);
+      // The widest vectors (16 pixels at a time where the CPU has AVX2) and SSE2's 8.
+      for (const KltVectors vectors : {KltVectors::kWidest, KltVectors::kSse2})
+        EXPECT_EQ(differingFromOpenCv(from, to, points, c, vectors), 0)
+            << "window " << c.window << ", levels " << c.levels << ", initial flow "
+            << c.initial_flow << (vectors == KltVectors::kSse2 ? ", SSE2" : ", widest")
+            << (steep ? ", squares" : ", blurred noise");
+    }
 }
 
 TEST(PyramidalKlt, GivesOpenCvsTracksOnRealEuRoCFrames) {
@@ -140,9 +164,12 @@ TEST(PyramidalKlt, GivesOpenCvsTracksOnRealEuRoCFrames) {
     cv::goodFeaturesToTrack(a, corners, 150, 0.01, 30);
     for (const cv::Size window : {cv::Size(21, 21), cv::Size(15, 15)}) {
       const Case c{window, 3, kDefaultStop, false};
-      EXPECT_EQ(differingFromOpenCv(pyramidOf(a, window, 3), pyramidOf(b, window, 3), corners, c),
-                0)
-          << images[k] << ", window " << window;
+      for (const KltVectors vectors : {KltVectors::kWidest, KltVectors::kSse2})
+        EXPECT_EQ(differingFromOpenCv(pyramidOf(a, window, 3), pyramidOf(b, window, 3), corners, c,
+                                      vectors),
+                  0)
+            << images[k] << ", window " << window
+            << (vectors == KltVectors::kSse2 ? ", SSE2" : ", widest");
     }
   }
 }

@@ -214,16 +214,21 @@ void BM_KltOpenCv(benchmark::State& state) {
                              cv::Size(window, window), 3, kKltStop);
 }
 BENCHMARK(BM_KltOpenCv)->Unit(benchmark::kMillisecond)->Arg(21)->Arg(15)->ArgName("window");
+// Second arg: 1 the widest vectors (AVX2 where the CPU has them), 0 SSE2 alone.
 void BM_KltAlvio(benchmark::State& state) {
   const int window = static_cast<int>(state.range(0));
+  const KltVectors vectors = state.range(1) ? KltVectors::kWidest : KltVectors::kSse2;
   const KltInput in = kltInput(window);
   std::vector<cv::Point2f> tracked;
   std::vector<uchar> status;
   for (auto _ : state)
     trackPyramidalKlt(in.from, in.to, in.corners, &tracked, &status, cv::Size(window, window), 3,
-                      kKltStop, false);
+                      kKltStop, false, vectors);
 }
-BENCHMARK(BM_KltAlvio)->Unit(benchmark::kMillisecond)->Arg(21)->Arg(15)->ArgName("window");
+BENCHMARK(BM_KltAlvio)
+    ->Unit(benchmark::kMillisecond)
+    ->ArgsProduct({{21, 15}, {1, 0}})
+    ->ArgNames({"window", "widest"});
 
 // The KLT pyramid with gradients of one frame, 3 levels above the first: OpenCV's
 // buildOpticalFlowPyramid against alvio's buildOpticalFlowPyramid8u (the same bytes). Arg: the
