@@ -78,7 +78,7 @@ struct Case {
 // Points whose position or status differ from OpenCV's (positions compared bit for bit).
 int differingFromOpenCv(const std::vector<cv::Mat>& from, const std::vector<cv::Mat>& to,
                         const std::vector<cv::Point2f>& points, const Case& c,
-                        KltVectors vectors = KltVectors::kWidest) {
+                        Vectors vectors = Vectors::kWidest) {
   std::vector<cv::Point2f> expected, got;
   if (c.initial_flow) {
     for (const cv::Point2f& p : points) expected.push_back(p + cv::Point2f(1.6f, -0.9f));
@@ -143,10 +143,10 @@ TEST(PyramidalKlt, GivesOpenCvsTracksBitForBit) {
       const std::vector<cv::Mat> from = pyramidOf(steep ? c0 : a, c.window, c.levels);
       const std::vector<cv::Mat> to = pyramidOf(steep ? c1 : b, c.window, c.levels);
       // The widest vectors (16 pixels at a time where the CPU has AVX2) and SSE2's 8.
-      for (const KltVectors vectors : {KltVectors::kWidest, KltVectors::kSse2})
+      for (const Vectors vectors : {Vectors::kWidest, Vectors::kBaseline})
         EXPECT_EQ(differingFromOpenCv(from, to, points, c, vectors), 0)
             << "window " << c.window << ", levels " << c.levels << ", initial flow "
-            << c.initial_flow << (vectors == KltVectors::kSse2 ? ", SSE2" : ", widest")
+            << c.initial_flow << (vectors == Vectors::kBaseline ? ", SSE2" : ", widest")
             << (steep ? ", squares" : ", blurred noise");
     }
 }
@@ -164,12 +164,12 @@ TEST(PyramidalKlt, GivesOpenCvsTracksOnRealEuRoCFrames) {
     cv::goodFeaturesToTrack(a, corners, 150, 0.01, 30);
     for (const cv::Size window : {cv::Size(21, 21), cv::Size(15, 15)}) {
       const Case c{window, 3, kDefaultStop, false};
-      for (const KltVectors vectors : {KltVectors::kWidest, KltVectors::kSse2})
+      for (const Vectors vectors : {Vectors::kWidest, Vectors::kBaseline})
         EXPECT_EQ(differingFromOpenCv(pyramidOf(a, window, 3), pyramidOf(b, window, 3), corners, c,
                                       vectors),
                   0)
             << images[k] << ", window " << window
-            << (vectors == KltVectors::kSse2 ? ", SSE2" : ", widest");
+            << (vectors == Vectors::kBaseline ? ", SSE2" : ", widest");
     }
   }
 }

@@ -217,7 +217,7 @@ BENCHMARK(BM_KltOpenCv)->Unit(benchmark::kMillisecond)->Arg(21)->Arg(15)->ArgNam
 // Second arg: 1 the widest vectors (AVX2 where the CPU has them), 0 SSE2 alone.
 void BM_KltAlvio(benchmark::State& state) {
   const int window = static_cast<int>(state.range(0));
-  const KltVectors vectors = state.range(1) ? KltVectors::kWidest : KltVectors::kSse2;
+  const Vectors vectors = state.range(1) ? Vectors::kWidest : Vectors::kBaseline;
   const KltInput in = kltInput(window);
   std::vector<cv::Point2f> tracked;
   std::vector<uchar> status;

@@ -7,6 +7,8 @@
 #include <type_traits>
 #include <unordered_set>
 
+#include "alvio/frontend/warped_patch_sums.h"
+
 namespace alvio {
 namespace {
 
@@ -214,40 +216,6 @@ Alignment PatchAnchors::refineShift(Patch& t, const cv::Mat& image, cv::Point2f*
 }
 
 namespace {
-// One pass over the warped patch (x' = A x + q, x the template offset): the sums every step
-// needs. `packed` holds per pixel {1, value, sd[0..5]}: sums[0] is the samples' sum, sums[1]
-// their product with the template, sums[2..7] with the steepest-descent images.
-void warpedSums(const cv::Mat& image, const Eigen::Matrix2d& A, double qx, double qy, int n,
-                const float* packed, float* s2, float* sums) {
-  const int h = n / 2;
-  const float a00 = static_cast<float>(A(0, 0)), a01 = static_cast<float>(A(0, 1));
-  const float a10 = static_cast<float>(A(1, 0)), a11 = static_cast<float>(A(1, 1));
-  const uchar* data = image.data;
-  const std::size_t step = image.step[0];
-  float acc[8] = {};
-  float sum2 = 0;
-  const float* block = packed;
-  for (int r = 0; r < n; ++r) {
-    const float y = static_cast<float>(r - h);
-    // Along a row the sample moves by A's first column per pixel.
-    float u = static_cast<float>(qx) - a00 * h + a01 * y;
-    float v = static_cast<float>(qy) - a10 * h + a11 * y;
-    for (int c = 0; c < n; ++c, u += a00, v += a10, block += 8) {
-      const int iu = static_cast<int>(u), iv = static_cast<int>(v);
-      const float fx = u - iu, fy = v - iv;
-      const uchar* row0 = data + iv * step + iu;
-      const uchar* row1 = row0 + step;
-      const float top = row0[0] + fx * (row0[1] - row0[0]);
-      const float bottom = row1[0] + fx * (row1[1] - row1[0]);
-      const float val = top + fy * (bottom - top);
-      sum2 += val * val;
-      for (int i = 0; i < 8; ++i) acc[i] += val * block[i];
-    }
-  }
-  *s2 = sum2;
-  for (int i = 0; i < 8; ++i) sums[i] = acc[i];
-}
-
 // The linear part of a warp step d (similarity: scale, rotation; affine: four entries).
 Eigen::Matrix2d linearStep(const Eigen::Matrix<double, 6, 1>& d, int k_params) {
   if (k_params == 4) return (Eigen::Matrix2d() << 1 + d[2], -d[3], d[3], 1 + d[2]).finished();
@@ -272,7 +240,9 @@ Alignment PatchAnchors::refineWarp(Patch& t, const cv::Mat& image, cv::Point2f* 
       }
     if (!inside) return Alignment::kOutside;  // also NaN
     float s2 = 0, sums[8];
-    warpedSums(image, A, qx, qy, n, t.packed.data(), &s2, sums);
+    // `packed` holds per pixel {1, value, sd[0..5]}: sums[0] is the samples' sum, sums[1]
+    // their product with the template, sums[2..7] with the steepest-descent images.
+    warpedPatchSums(image, A, qx, qy, n, t.packed.data(), &s2, sums);
     const float s1 = sums[0], st = sums[1];
     const float* sg = sums + 2;
     const double mean = s1 / count;

@@ -123,9 +123,7 @@ inline float reduceSum(__m128 v) {
   return _mm_cvtss_f32(v);
 }
 
-#if defined(__GNUC__) && defined(__x86_64__)
-#define ALVIO_KLT_AVX2 1
-#define ALVIO_AVX2_FUNCTION __attribute__((target("avx2")))
+#if ALVIO_AVX2_CODE
 
 // Sixteen pixels at a time: two of OpenCV's 8-pixel blocks side by side, one in each 128-bit
 // half. Every integer step is the same as in the 8-pixel code, only twice as wide; the float
@@ -134,13 +132,13 @@ struct Bilinear2 {
   __m256i top, bottom;
 };
 
-ALVIO_AVX2_FUNCTION inline Bilinear2 widen(const Bilinear& w) {
+ALVIO_AVX2 inline Bilinear2 widen(const Bilinear& w) {
   return {_mm256_broadcastsi128_si256(w.top), _mm256_broadcastsi128_si256(w.bottom)};
 }
 
 template <int kShift>
-ALVIO_AVX2_FUNCTION inline __m256i interpolate2(__m256i v00, __m256i v01, __m256i v10, __m256i v11,
-                                                const Bilinear2& w) {
+ALVIO_AVX2 inline __m256i interpolate2(__m256i v00, __m256i v01, __m256i v10, __m256i v11,
+                                       const Bilinear2& w) {
   const __m256i round = _mm256_set1_epi32(1 << (kShift - 1));
   const __m256i lo = _mm256_add_epi32(
       _mm256_add_epi32(_mm256_madd_epi16(_mm256_unpacklo_epi16(v00, v01), w.top), round),
@@ -151,24 +149,23 @@ ALVIO_AVX2_FUNCTION inline __m256i interpolate2(__m256i v00, __m256i v01, __m256
   return _mm256_packs_epi32(_mm256_srai_epi32(lo, kShift), _mm256_srai_epi32(hi, kShift));
 }
 
-ALVIO_AVX2_FUNCTION inline __m256i loadWidened(const uchar* q) {
+ALVIO_AVX2 inline __m256i loadWidened(const uchar* q) {
   return _mm256_cvtepu8_epi16(_mm_loadu_si128(reinterpret_cast<const __m128i*>(q)));
 }
 
 // interpolate8 for p[0..15]: pixels 0-7 in the low half, 8-15 in the high half.
-ALVIO_AVX2_FUNCTION inline __m256i interpolate16(const uchar* p, std::ptrdiff_t step,
-                                                 const Bilinear2& w) {
+ALVIO_AVX2 inline __m256i interpolate16(const uchar* p, std::ptrdiff_t step, const Bilinear2& w) {
   return interpolate2<kWeightBits - 5>(loadWidened(p), loadWidened(p + 1), loadWidened(p + step),
                                        loadWidened(p + step + 1), w);
 }
 
-ALVIO_AVX2_FUNCTION inline __m256i loadShorts(const short* q) {
+ALVIO_AVX2 inline __m256i loadShorts(const short* q) {
   return _mm256_loadu_si256(reinterpret_cast<const __m256i*>(q));
 }
 
 // interpolateGradients4 for eight pixels: pixels 0-3 in the low half, 4-7 in the high half.
-ALVIO_AVX2_FUNCTION inline __m256i interpolateGradients8(const short* d, std::ptrdiff_t step,
-                                                         const Bilinear2& w) {
+ALVIO_AVX2 inline __m256i interpolateGradients8(const short* d, std::ptrdiff_t step,
+                                                const Bilinear2& w) {
   return interpolate2<kWeightBits>(loadShorts(d), loadShorts(d + 2), loadShorts(d + step),
                                    loadShorts(d + step + 2), w);
 }
@@ -279,7 +276,7 @@ class LevelTracker {
                         dI_.ptr<short>() + at.y * step_d + at.x * 2, step_i, step_d};
     ProductSums q{_mm_setzero_ps(), _mm_setzero_ps(), _mm_setzero_ps()};
     TailSums tails;
-#if ALVIO_KLT_AVX2
+#if ALVIO_AVX2_CODE
     if (wide_)
       templateRowsWide(window, w, buf, &q, &tails);
     else
@@ -297,7 +294,7 @@ class LevelTracker {
     const uchar* image = J_.ptr() + at.y * step_j + at.x;
     __m128 qb0 = _mm_setzero_ps(), qb1 = _mm_setzero_ps();
     float ib1 = 0, ib2 = 0;
-#if ALVIO_KLT_AVX2
+#if ALVIO_AVX2_CODE
     if (wide_)
       mismatchRowsWide(image, step_j, w, buf, &qb0, &qb1, &ib1, &ib2);
     else
@@ -442,10 +439,10 @@ class LevelTracker {
     }
   }
 
-#if ALVIO_KLT_AVX2
+#if ALVIO_AVX2_CODE
   // The products of eight pixels' gradients (pixels 0-3 in the low half, 4-7 in the high
   // half) added to q: the low half's, then the high half's, as two 4-pixel steps would.
-  ALVIO_AVX2_FUNCTION static void accumulateWide(__m256i g, ProductSums* q) {
+  ALVIO_AVX2 static void accumulateWide(__m256i g, ProductSums* q) {
     const __m256 fx = _mm256_cvtepi32_ps(_mm256_srai_epi32(_mm256_slli_epi32(g, 16), 16));
     const __m256 fy = _mm256_cvtepi32_ps(_mm256_srai_epi32(g, 16));
     const __m256 yy = _mm256_mul_ps(fy, fy), xy = _mm256_mul_ps(fx, fy), xx = _mm256_mul_ps(fx, fx);
@@ -460,8 +457,8 @@ class LevelTracker {
   // templateRows two blocks at a time. The paired gradients of a block pair are kept as
   // [lo(0) lo(1)] [hi(0) hi(1)], where lo and hi are templateBlock's two stores: each half then
   // meets its block's differences in mismatchRowsWide.
-  ALVIO_AVX2_FUNCTION void templateRowsWide(const Window& window, const Bilinear& w1, Buffers* buf,
-                                            ProductSums* q_out, TailSums* tails_out) const {
+  ALVIO_AVX2 void templateRowsWide(const Window& window, const Bilinear& w1, Buffers* buf,
+                                   ProductSums* q_out, TailSums* tails_out) const {
     // Not inlined into its caller (another target): sums kept in locals stay in registers.
     ProductSums sums = *q_out, *q = &sums;
     TailSums tail_sums = *tails_out, *tails = &tail_sums;
@@ -495,9 +492,9 @@ class LevelTracker {
   }
 
   // mismatchRows two blocks at a time: each half's sums added in block order.
-  ALVIO_AVX2_FUNCTION void mismatchRowsWide(const uchar* image, std::ptrdiff_t step_j,
-                                            const Bilinear& w1, const Buffers& buf, __m128* qb0_out,
-                                            __m128* qb1_out, float* ib1_out, float* ib2_out) const {
+  ALVIO_AVX2 void mismatchRowsWide(const uchar* image, std::ptrdiff_t step_j, const Bilinear& w1,
+                                   const Buffers& buf, __m128* qb0_out, __m128* qb1_out,
+                                   float* ib1_out, float* ib2_out) const {
     __m128 b0 = *qb0_out, b1 = *qb1_out, *qb0 = &b0, *qb1 = &b1;
     float s1 = *ib1_out, s2 = *ib2_out, *ib1 = &s1, *ib2 = &s2;
     const Bilinear2 w = widen(w1);
@@ -551,7 +548,7 @@ void trackPyramidalKlt(const std::vector<cv::Mat>& from_pyramid,
                        const std::vector<cv::Mat>& to_pyramid, const std::vector<cv::Point2f>& from,
                        std::vector<cv::Point2f>* to, std::vector<uchar>* status, cv::Size window,
                        int max_level, const cv::TermCriteria& stop, bool use_initial_flow,
-                       KltVectors vectors) {
+                       Vectors vectors) {
 #if defined(__SSE2__)
   const bool supported = !from_pyramid.empty() && !to_pyramid.empty() && max_level >= 0 &&
                          window.width >= 8 && window.height > 2 &&
@@ -575,9 +572,8 @@ void trackPyramidalKlt(const std::vector<cv::Mat>& from_pyramid,
   double epsilon =
       (stop.type & cv::TermCriteria::EPS) ? std::min(std::max(stop.epsilon, 0.), 10.) : 0.01;
   epsilon *= epsilon;
-#if ALVIO_KLT_AVX2
-  static const bool kHasAvx2 = __builtin_cpu_supports("avx2");
-  const bool wide = vectors == KltVectors::kWidest && kHasAvx2;
+#if ALVIO_AVX2_CODE
+  const bool wide = vectors == Vectors::kWidest && cpuHasAvx2();
 #else
   const bool wide = false;
 #endif

@@ -9,3 +9,31 @@
 #else
 #define ALVIO_WIDEST_VECTORS
 #endif
+
+// Hand-written AVX2 intrinsics go in functions marked ALVIO_AVX2, built where ALVIO_AVX2_CODE
+// is 1 and called only when cpuHasAvx2(). Such a function is not inlined into code built for
+// the baseline: sums it carries through a loop belong in its locals, not behind pointers.
+#if defined(__GNUC__) && defined(__x86_64__)
+#define ALVIO_AVX2_CODE 1
+#define ALVIO_AVX2 __attribute__((target("avx2")))
+#else
+#define ALVIO_AVX2_CODE 0
+#define ALVIO_AVX2
+#endif
+
+namespace alvio {
+
+/// Which of a function's hand-written vector paths to take: the widest the CPU has, or the
+/// baseline's (SSE2 on x86-64). Both give the same bits; the choice is for tests and benchmarks.
+enum class Vectors { kWidest, kBaseline };
+
+inline bool cpuHasAvx2() {
+#if ALVIO_AVX2_CODE
+  static const bool has = __builtin_cpu_supports("avx2");
+  return has;
+#else
+  return false;
+#endif
+}
+
+}  // namespace alvio

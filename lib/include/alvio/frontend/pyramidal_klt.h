@@ -13,10 +13,9 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
-namespace alvio {
+#include "alvio/common/widest_vectors.h"
 
-/// The widest vectors the CPU has (AVX2 or SSE2), or SSE2 alone; the tracks are the same.
-enum class KltVectors { kWidest, kSse2 };
+namespace alvio {
 
 /// Same arguments and results as cv::calcOpticalFlowPyrLK(from_pyramid, to_pyramid, from, *to,
 /// *status, cv::noArray(), window, max_level, stop, use_initial_flow ?
@@ -28,6 +27,6 @@ void trackPyramidalKlt(const std::vector<cv::Mat>& from_pyramid,
                        const std::vector<cv::Mat>& to_pyramid, const std::vector<cv::Point2f>& from,
                        std::vector<cv::Point2f>* to, std::vector<uchar>* status, cv::Size window,
                        int max_level, const cv::TermCriteria& stop, bool use_initial_flow,
-                       KltVectors vectors = KltVectors::kWidest);
+                       Vectors vectors = Vectors::kWidest);
 
 }  // namespace alvio
