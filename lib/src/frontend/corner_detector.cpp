@@ -61,27 +61,6 @@ double maxInsideMask(const cv::Mat& response, const cv::Mat& mask) {
   }
   return any ? best : 0.0;
 }
-
-// Narrows [*begin, *end) to the span from its first to its last non-zero mask byte; false
-// when it has none. Sixteen bytes at a time: most rows of a tracking frame's mask are long
-// runs of zeros around the tracked corners' discs.
-bool narrowToNonZero(const uchar* m, int* begin, int* end) {
-  int b = *begin, e = *end;
-#if defined(__SSE2__)
-  const __m128i zero = _mm_setzero_si128();
-  auto zeros16 = [&](int x) {
-    return _mm_movemask_epi8(_mm_cmpeq_epi8(
-               _mm_loadu_si128(reinterpret_cast<const __m128i*>(m + x)), zero)) == 0xffff;
-  };
-  while (b + 16 <= e && zeros16(b)) b += 16;
-  while (e - 16 >= b && zeros16(e - 16)) e -= 16;
-#endif
-  while (b < e && m[b] == 0) ++b;
-  while (e > b && m[e - 1] == 0) --e;
-  *begin = b;
-  *end = e;
-  return b < e;
-}
 }  // namespace
 
 std::vector<cv::Point2f> CornerDetector::detect(const cv::Mat& image, int max_corners,
@@ -106,19 +85,15 @@ std::vector<cv::Point2f> CornerDetector::detect(const cv::Mat& image, int max_co
   Candidate* out = candidates_.data();
   for (int y = 1; y < h - 1; ++y) {
     const uchar* m = mask.empty() ? nullptr : mask.ptr<uchar>(y);
-    // Candidates lie in the row's inner columns [begin, end), narrowed to the mask's span.
-    int begin = 1, end = w - 1;
-    if (m && !narrowToNonZero(m, &begin, &end)) continue;
     const float* __restrict above = response_.ptr<float>(y - 1);
     const float* __restrict row = response_.ptr<float>(y);
     const float* __restrict below = response_.ptr<float>(y + 1);
-    for (int x = begin - 1; x < end + 1; ++x)
-      column_max[x] = std::max(std::max(above[x], row[x]), below[x]);
-    int x = begin;
+    for (int x = 0; x < w; ++x) column_max[x] = std::max(std::max(above[x], row[x]), below[x]);
+    int x = 1;
 #if defined(__SSE2__)
     // Four pixels tested at once; the few that are kept are written one by one, in order.
     const __m128 above_threshold = _mm_set1_ps(std::max(threshold, 0.0f));
-    for (; x + 4 <= end; x += 4) {
+    for (; x + 4 <= w - 1; x += 4) {
       std::uint32_t four = 0xffffffffu;
       if (m) {
         std::memcpy(&four, m + x, 4);
@@ -139,7 +114,7 @@ std::vector<cv::Point2f> CornerDetector::detect(const cv::Mat& image, int max_co
       }
     }
 #endif
-    for (; x < end; ++x) {
+    for (; x < w - 1; ++x) {
       const float v = row[x];
       const float block_max =
           std::max(std::max(column_max[x - 1], column_max[x]), column_max[x + 1]);
