@@ -13,6 +13,7 @@
 #include "alvio/estimator/estimator.h"
 #include "alvio/estimator/factors/bias_prior_factor.h"
 #include "alvio/estimator/factors/imu_factor.h"
+#include "alvio/estimator/factors/line_step_damping_factor.h"
 #include "alvio/estimator/factors/marginalization.h"
 #include "alvio/estimator/factors/point_projection_factor.h"
 #include "alvio/estimator/point_noise.h"
@@ -241,6 +242,9 @@ void Estimator::optimize(FrameTiming* timing, int max_iterations) {
       for (const auto& [ns, obs] : l.observations)
         problem.AddResidualBlock(newLineFactor(obs), loss.get(), para_pose_[slot.at(ns)].data(),
                                  line_block);
+      if (options_.line_step_damping > 0)
+        problem.AddResidualBlock(new LineStepDampingFactor(line_block, options_.line_step_damping),
+                                 nullptr, line_block);
     }
   }
 

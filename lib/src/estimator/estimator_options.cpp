@@ -36,6 +36,7 @@ EstimatorOptions EstimatorOptions::load(const YamlReader& yaml, const std::strin
   o.line_sigma_px = yaml.getDouble(p + "line_sigma_px", o.line_sigma_px);
   o.line_min_observations = yaml.getInt(p + "line_min_observations", o.line_min_observations);
   o.line_outlier_px = yaml.getDouble(p + "line_outlier_px", o.line_outlier_px);
+  o.line_step_damping = yaml.getDouble(p + "line_step_damping", o.line_step_damping);
   o.line_triangulation = LineTriangulationOptions::load(yaml, p + "line_triangulation");
   o.line_map_max_rms_px = yaml.getDouble(p + "line_map_max_rms_px", o.line_map_max_rms_px);
   o.line_map_min_parallax = yaml.getDouble(p + "line_map_min_parallax", o.line_map_min_parallax);
@@ -78,6 +79,8 @@ EstimatorOptions EstimatorOptions::load(const YamlReader& yaml, const std::strin
   if (o.line_sigma_px <= 0) throw Error(yaml.where(p + "line_sigma_px") + " must be positive");
   if (o.line_min_observations < 2)
     throw Error(yaml.where(p + "line_min_observations") + " must be at least 2");
+  if (o.line_step_damping < 0)
+    throw Error(yaml.where(p + "line_step_damping") + " must not be negative (0: off)");
   if (o.line_map_min_parallax < 0)
     throw Error(yaml.where(p + "line_map_min_parallax") + " must not be negative (0: no limit)");
   if (o.imu_noise_scale <= 0) throw Error(yaml.where(p + "imu_noise_scale") + " must be positive");

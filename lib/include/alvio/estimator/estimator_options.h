@@ -38,6 +38,9 @@ struct EstimatorOptions {
   double line_sigma_px = 1.5;     ///< endpoint-to-line noise of line observations
   int line_min_observations = 3;  ///< window observations before a line is used
   double line_outlier_px = 5.0;   ///< lines with a larger mean endpoint error are removed
+  /// Square root of the information [1/rad] pulling each line back to where the solve
+  /// started it (LineStepDampingFactor); 0: off.
+  double line_step_damping = 0.0;
   LineTriangulationOptions line_triangulation;
   /// A retired line reaches the maps only if its whole track fits it within this RMS
   /// endpoint distance [px] (<= 0: no limit) and the cameras moved across it by at least this
