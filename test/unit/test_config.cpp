@@ -106,9 +106,20 @@ TEST(Config, LineMapFilterIsReadAndANegativeParallaxIsRejected) {
                         {"estimator.line_map_min_parallax", "must not be negative"});
 }
 
+TEST(Config, LineStepDampingIsReadAndANegativeOneIsRejected) {
+  const Config c = Config::load(test::sourcePath("config/euroc.yaml"));
+  EXPECT_EQ(c.estimator.line_step_damping, 10.0);
+  const std::string dir = test::scratchDir();
+  const std::string path =
+      test::writeFile(dir + "/damping.yaml",
+                      eurocYamlReplacing("line_step_damping: 10.0", "line_step_damping: -1.0"));
+  expectErrorMentioning([&] { Config::load(path); },
+                        {"estimator.line_step_damping", "must not be negative"});
+}
+
 TEST(Config, SolverIterationsAreReadAndZeroForTheFirstSolveIsRejected) {
   const Config c = Config::load(test::sourcePath("config/euroc.yaml"));
-  EXPECT_EQ(c.estimator.max_iterations, 5);
+  EXPECT_EQ(c.estimator.max_iterations, 2);
   EXPECT_EQ(c.estimator.init_max_iterations, 24);
   const std::string dir = test::scratchDir();
   const std::string path = test::writeFile(

@@ -14,7 +14,7 @@ class YamlReader;
 struct EstimatorOptions {
   int window_size = 10;                ///< keyframes in the window (plus the newest frame)
   double keyframe_parallax_px = 10;    ///< mean parallax that makes a frame a keyframe
-  int max_iterations = 5;              ///< Ceres iterations per frame (no time limit: determinism)
+  int max_iterations = 2;              ///< Ceres iterations per frame (no time limit: determinism)
   int init_max_iterations = 24;        ///< ...for the first solve after (re-)initialisation
   int num_threads = 1;                 ///< Ceres threads
   double point_sigma_px = 1.5;         ///< reprojection noise of points
@@ -40,7 +40,7 @@ struct EstimatorOptions {
   double line_outlier_px = 5.0;   ///< lines with a larger mean endpoint error are removed
   /// Square root of the information [1/rad] pulling each line back to where the solve
   /// started it (LineStepDampingFactor); 0: off.
-  double line_step_damping = 0.0;
+  double line_step_damping = 10.0;
   LineTriangulationOptions line_triangulation;
   /// A retired line reaches the maps only if its whole track fits it within this RMS
   /// endpoint distance [px] (<= 0: no limit) and the cameras moved across it by at least this
