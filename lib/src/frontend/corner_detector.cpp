@@ -16,6 +16,16 @@ namespace {
 // ranking it costs little next to the response image.
 constexpr std::ptrdiff_t kBlock = 2048;
 
+#if defined(__SSE2__)
+// Four mask bytes (the first in the low byte) as four float lanes: all ones where non-zero.
+inline __m128 nonZeroLanes(std::uint32_t four) {
+  const __m128i zero = _mm_setzero_si128();
+  const __m128i bytes = _mm_cvtsi32_si128(static_cast<int>(four));
+  const __m128i lanes = _mm_unpacklo_epi16(_mm_unpacklo_epi8(bytes, zero), zero);
+  return _mm_castsi128_ps(_mm_cmpgt_epi32(lanes, zero));
+}
+#endif
+
 // cv::minMaxLoc's maximum inside the mask (0 when the mask is empty of pixels), without its
 // search for locations. Four pixels at a time: GCC does not vectorise a float maximum without
 // -ffast-math, and this loop was a third of the detector's time. The response has no NaN, so
@@ -31,7 +41,6 @@ double maxInsideMask(const cv::Mat& response, const cv::Mat& mask) {
     int x = 0;
 #if defined(__SSE2__)
     const __m128 lowest = _mm_set1_ps(kLowest);
-    const __m128i zero = _mm_setzero_si128();
     __m128 best4 = lowest;
     for (; x + 4 <= w; x += 4) {
       const __m128 v = _mm_loadu_ps(row + x);
@@ -43,10 +52,7 @@ double maxInsideMask(const cv::Mat& response, const cv::Mat& mask) {
       std::memcpy(&four, m + x, 4);
       if (four == 0) continue;  // masked stretches are long: a predictable branch
       any = true;
-      // Each mask byte widened to a lane: all ones where the byte is non-zero.
-      const __m128i bytes = _mm_cvtsi32_si128(static_cast<int>(four));
-      const __m128i lanes = _mm_unpacklo_epi16(_mm_unpacklo_epi8(bytes, zero), zero);
-      const __m128 inside = _mm_castsi128_ps(_mm_cmpgt_epi32(lanes, zero));
+      const __m128 inside = nonZeroLanes(four);
       best4 = _mm_max_ps(best4, _mm_or_ps(_mm_and_ps(inside, v), _mm_andnot_ps(inside, lowest)));
     }
     float lanes[4];
@@ -103,10 +109,9 @@ std::vector<cv::Point2f> CornerDetector::detect(const cv::Mat& image, int max_co
       const __m128 block_max =
           _mm_max_ps(_mm_max_ps(_mm_loadu_ps(column_max + x - 1), _mm_loadu_ps(column_max + x)),
                      _mm_loadu_ps(column_max + x + 1));
-      int keep =
-          _mm_movemask_ps(_mm_and_ps(_mm_cmpgt_ps(v, above_threshold), _mm_cmpge_ps(v, block_max)));
-      for (int k = 0; k < 4; ++k)
-        if (((four >> (8 * k)) & 0xff) == 0) keep &= ~(1 << k);
+      const __m128 strongest =
+          _mm_and_ps(_mm_cmpgt_ps(v, above_threshold), _mm_cmpge_ps(v, block_max));
+      int keep = _mm_movemask_ps(_mm_and_ps(strongest, nonZeroLanes(four)));
       while (keep) {
         const int k = __builtin_ctz(static_cast<unsigned>(keep));
         keep &= keep - 1;
