@@ -11,17 +11,14 @@
 #include <vector>
 
 #include "alvio/frontend/corner_detector.h"
+#include "test_images.h"
 #include "test_support.h"
 
 using namespace alvio;
 
 namespace {
 cv::Mat texture(cv::Size size, int seed) {
-  cv::Mat noise(size, CV_8UC1);
-  cv::RNG rng(seed);
-  rng.fill(noise, cv::RNG::UNIFORM, 0, 256);
-  cv::GaussianBlur(noise, noise, cv::Size(0, 0), 2.0);
-  return noise;
+  return test::blurredNoise(size, seed, 2.0);
 }
 
 // Equal responses everywhere inside: the tie rule decides the order.

@@ -12,6 +12,7 @@
 #include "alvio/frontend/point_tracker.h"
 #include "alvio/pipeline/front_end.h"
 #include "synthetic_line_scene.h"
+#include "test_images.h"
 #include "test_support.h"
 
 using namespace alvio;
@@ -54,11 +55,7 @@ TEST(PointTracker, NewCornersWaitUntilEnoughAreMissing) {
   const int w = config.camera.width, h = config.camera.height;
   // A wide texture seen through a window that slides left: the content moves right and
   // corners leave the image on the right, a known few a frame.
-  cv::Mat texture(h, w + 400, CV_8UC1);
-  cv::RNG rng(7);
-  rng.fill(texture, cv::RNG::UNIFORM, 0, 255);
-  cv::GaussianBlur(texture, texture, cv::Size(0, 0), 3.0);
-  cv::normalize(texture, texture, 0, 255, cv::NORM_MINMAX);
+  const cv::Mat texture = test::stretched(test::blurredNoise(cv::Size(w + 400, h), 7, 3.0));
   const auto view = [&](int shift) { return texture(cv::Rect(400 - shift, 0, w, h)).clone(); };
   const auto maxId = [](const FeatureFrame& f) {
     int m = -1;
@@ -103,13 +100,8 @@ TEST(PointTracker, AlignedCornersSkipTheBackwardCheckAndOccludedOnesStillEnd) {
   const Config config = Config::load(test::sourcePath("config/euroc.yaml"));
   const std::shared_ptr<const CameraModel> camera = CameraModel::create(config.camera);
   const int w = config.camera.width, h = config.camera.height;
-  cv::Mat texture(h, w + 400, CV_8UC1), other(h, w, CV_8UC1);
-  cv::RNG rng(11);
-  for (cv::Mat* m : {&texture, &other}) {
-    rng.fill(*m, cv::RNG::UNIFORM, 0, 255);
-    cv::GaussianBlur(*m, *m, cv::Size(0, 0), 3.0);
-    cv::normalize(*m, *m, 0, 255, cv::NORM_MINMAX);
-  }
+  const cv::Mat texture = test::stretched(test::blurredNoise(cv::Size(w + 400, h), 11, 3.0));
+  const cv::Mat other = test::stretched(test::blurredNoise(cv::Size(w, h), 12, 3.0));
   // The content slides right by `shift` pixels.
   const auto view = [&](int shift) { return texture(cv::Rect(400 - shift, 0, w, h)).clone(); };
   // In the last frame an unrelated surface covers the image's left third.

@@ -15,6 +15,7 @@
 #include "alvio/frontend/rotated_pixels.h"
 #include "alvio/lines/optical_flow_line_tracker.h"
 #include "synthetic_line_scene.h"
+#include "test_images.h"
 #include "test_support.h"
 
 using namespace alvio;
@@ -141,11 +142,8 @@ TEST(RotatedPixels, MovesPixelsAsTheRotationDoesAndKeepsThoseTurnedBehind) {
 TEST(PointTracker, TheGyroscopesRotationCarriesCornersThroughAFastTurn) {
   const Config config = Config::load(test::sourcePath("config/euroc.yaml"));
   const std::shared_ptr<const CameraModel> camera = CameraModel::create(test::undistortedCamera());
-  cv::Mat texture(camera->height(), camera->width(), CV_8UC1);
-  cv::RNG rng(11);
-  rng.fill(texture, cv::RNG::UNIFORM, 0, 255);
-  cv::GaussianBlur(texture, texture, cv::Size(0, 0), 3.0);
-  cv::normalize(texture, texture, 0, 255, cv::NORM_MINMAX);
+  const cv::Mat texture =
+      test::stretched(test::blurredNoise(cv::Size(camera->width(), camera->height()), 11, 3.0));
   const Eigen::Matrix3d R = fastTurn();
   const cv::Mat second = turned(texture, *camera, R);
 

@@ -9,18 +9,12 @@
 #include <vector>
 
 #include "alvio/frontend/min_eigen_response.h"
+#include "test_images.h"
 #include "test_support.h"
 
 using namespace alvio;
 
 namespace {
-cv::Mat texture(cv::Size size, int seed, double blur) {
-  cv::Mat img(size, CV_8UC1);
-  cv::RNG rng(seed);
-  rng.fill(img, cv::RNG::UNIFORM, 0, 256);
-  if (blur > 0) cv::GaussianBlur(img, img, cv::Size(0, 0), blur);
-  return img;
-}
 
 // Within OpenCV's rounding: 1e-4 of the image's strongest response (3e-5 measured).
 void expectMatchesOpenCv(MinEigenResponse* calculator, const cv::Mat& img) {
@@ -49,7 +43,7 @@ TEST(MinEigenResponse, MatchesOpenCvOnTexturesOfAnySize) {
   for (const cv::Size size :
        {cv::Size(752, 480), cv::Size(37, 23), cv::Size(3, 3), cv::Size(4, 7), cv::Size(640, 1)})
     for (double blur : {0.0, 1.5})
-      expectMatchesOpenCv(&calculator, texture(size, size.area(), blur));
+      expectMatchesOpenCv(&calculator, test::blurredNoise(size, size.area(), blur));
 }
 
 TEST(MinEigenResponse, MatchesOpenCvOnSaturatedEdges) {

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "alvio/frontend/pyramidal_klt.h"
+#include "test_images.h"
 #include "test_support.h"
 
 using namespace alvio;
@@ -16,13 +17,8 @@ using namespace alvio;
 namespace {
 
 // Blurred noise: texture at several scales, as KLT needs.
-cv::Mat texture(cv::Size size, int seed, double blur = 2.0) {
-  cv::RNG rng(seed);
-  cv::Mat noise(size, CV_8UC1), image;
-  rng.fill(noise, cv::RNG::UNIFORM, 0, 256);
-  cv::GaussianBlur(noise, image, cv::Size(0, 0), blur);
-  cv::normalize(image, image, 0, 255, cv::NORM_MINMAX);
-  return image;
+cv::Mat texture(cv::Size size, int seed) {
+  return test::stretched(test::blurredNoise(size, seed, 2.0));
 }
 
 // Black and white squares of random sizes, slightly blurred: steep gradients and large

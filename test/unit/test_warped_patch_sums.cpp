@@ -7,18 +7,11 @@
 #include <vector>
 
 #include "alvio/frontend/warped_patch_sums.h"
+#include "test_images.h"
 
 using namespace alvio;
 
 namespace {
-
-cv::Mat noiseImage(cv::Size size, int seed) {
-  cv::Mat image(size, CV_8UC1);
-  cv::RNG rng(seed);
-  rng.fill(image, cv::RNG::UNIFORM, 0, 256);
-  cv::GaussianBlur(image, image, cv::Size(0, 0), 1.0);
-  return image;
-}
 
 std::vector<float> randomPacked(int n, int seed) {
   std::vector<float> packed(std::size_t(n) * n * 8);
@@ -45,7 +38,7 @@ bool sameBits(const Sums& a, const Sums& b) {
 }  // namespace
 
 TEST(WarpedPatchSums, WidestVectorsGiveTheBaselinesBits) {
-  const cv::Mat image = noiseImage(cv::Size(160, 120), 1);
+  const cv::Mat image = test::blurredNoise(cv::Size(160, 120), 1, 1.0);
   cv::RNG rng(2);
   int compared = 0;
   for (const int n : {21, 15, 9, 7, 33}) {
@@ -68,7 +61,7 @@ TEST(WarpedPatchSums, WidestVectorsGiveTheBaselinesBits) {
 }
 
 TEST(WarpedPatchSums, SumTheBilinearSamples) {
-  const cv::Mat image = noiseImage(cv::Size(64, 48), 3);
+  const cv::Mat image = test::blurredNoise(cv::Size(64, 48), 3, 1.0);
   const int n = 9, h = n / 2;
   const std::vector<float> packed = randomPacked(n, 4);
   Eigen::Matrix2d A;
