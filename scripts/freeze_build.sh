@@ -5,6 +5,11 @@
 # each other (patchelf), so a frozen program run by hand loads the frozen libraries too.
 #
 #   scripts/freeze_build.sh OUT_DIR        (scripts/bench.py --freeze does it for you)
+#
+# Only programs and libraries are copied, not config/: a frozen program reads the --config it
+# is given, and scripts/bench.py --bin FROZEN (without --freeze) passes the source tree's
+# config/, which may have moved on since (an older build warns about keys it does not know and
+# ignores them). scripts/bench.py --freeze also copies config/ into OUT_DIR/config and uses it.
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BUILD="${ALVIO_BUILD_DIR:-$ROOT/build}"
