@@ -6,7 +6,6 @@
 #include "alvio/config/config.h"
 #include "alvio/frontend/exposure_compensation.h"
 #include "alvio/pipeline/front_end.h"
-#include "test_images.h"
 #include "test_support.h"
 
 using namespace alvio;
@@ -15,7 +14,12 @@ namespace {
 
 // Blurred noise: corners everywhere, like a textured wall.
 cv::Mat texture(int width, int height, uint64_t seed) {
-  return test::stretched(test::blurredNoise(cv::Size(width, height), seed, 2.0), 20, 230);
+  cv::Mat image(height, width, CV_8UC1);
+  cv::theRNG().state = seed;
+  cv::randu(image, 0, 255);
+  cv::GaussianBlur(image, image, cv::Size(0, 0), 2.0);
+  cv::normalize(image, image, 20, 230, cv::NORM_MINMAX);
+  return image;
 }
 
 cv::Mat scaled(const cv::Mat& image, double gain) {
@@ -76,7 +80,7 @@ TEST(ExposureCompensation, SlowDriftAndBlackFramesPassUntouched) {
 }
 
 // The front end on a textured frame, then the same view 2 px on with the light at 30 %:
-// with compensation nearly all tracks survive; without, KLT loses a third or more.
+// with compensation most tracks survive; without, KLT loses them (the reason for it).
 TEST(ExposureCompensation, FrontEndKeepsTracksThroughALightDrop) {
   Config config = Config::load(test::sourcePath("config/euroc.yaml"));
   config.estimator.use_lines = false;
@@ -94,9 +98,7 @@ TEST(ExposureCompensation, FrontEndKeepsTracksThroughALightDrop) {
     EXPECT_NEAR(b.mean_intensity, meanOf(second), 1e-6) << "mean_intensity is the raw light";
     return kept;
   };
-  // Over ten textures, with compensation 145-149 of about 150 tracks survived, without it
-  // 74-95 (the ratio varies from 1.6 to 2.0 with the texture).
   const int with = trackedIntoSecond(0.15), without = trackedIntoSecond(0.0);
-  EXPECT_GT(with, 140) << "with compensation";
-  EXPECT_LT(3 * without, 2 * with) << "with " << with << ", without " << without;
+  EXPECT_GT(with, 100) << "with compensation";
+  EXPECT_GT(with, 2 * without) << "with " << with << ", without " << without;
 }
