@@ -5,6 +5,7 @@
 // per tracker: track length, fraction of correct associations, fraction of tracks on one edge,
 // Type 3 / Type 4 events, lines and time per frame.
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
@@ -30,6 +31,17 @@ namespace fs = std::filesystem;
 
 namespace {
 
+nlohmann::json toJson(const std::vector<EndpointErrorBin>& bins) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const EndpointErrorBin& b : bins)
+    out.push_back({{"min_length_px", b.min_length_px},
+                   {"max_length_px", std::isinf(b.max_length_px) ? -1.0 : b.max_length_px},
+                   {"endpoints", b.endpoints},
+                   {"rms_px", b.rms_px},
+                   {"median_px", b.median_px}});
+  return out;
+}
+
 nlohmann::json toJson(const LineTrackTruthSummary& s) {
   return {{"frames", s.frames},
           {"observations", s.observations},
@@ -43,6 +55,7 @@ nlohmann::json toJson(const LineTrackTruthSummary& s) {
           {"strict_correct_fraction", s.strict_correct_fraction},
           {"single_edge_track_fraction", s.single_edge_track_fraction},
           {"median_endpoint_distance_px", s.median_endpoint_distance_px},
+          {"endpoint_error_by_length", toJson(s.endpoint_error_by_length)},
           {"type3_merged", s.type3_merged},
           {"type4_clipped", s.type4_clipped},
           {"ms_per_frame", {{"mean", s.mean_ms}, {"median", s.median_ms}}}};
@@ -58,7 +71,18 @@ void print(const std::string& name, const LineTrackTruthSummary& s) {
             << 100 * s.single_edge_track_fraction << " % of " << s.evaluated_tracks << "  type3 "
             << s.type3_merged << "  type4 " << s.type4_clipped << "  ms/frame " << s.mean_ms
             << " (median " << s.median_ms << ")  endpoint error median "
-            << s.median_endpoint_distance_px << " px\n";
+            << s.median_endpoint_distance_px
+            << " px\n             endpoint error by length "
+               "(px: endpoints, rms):";
+  for (const EndpointErrorBin& b : s.endpoint_error_by_length) {
+    std::cout << "  " << std::setprecision(0) << b.min_length_px;
+    if (std::isinf(b.max_length_px))
+      std::cout << "+";
+    else
+      std::cout << "-" << b.max_length_px;
+    std::cout << ": " << b.endpoints << ", " << std::setprecision(2) << b.rms_px;
+  }
+  std::cout << "\n";
 }
 
 // The pinhole camera of the undistorted image the trackers report in (same K, no distortion).

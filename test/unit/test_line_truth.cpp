@@ -3,6 +3,9 @@
 // from its own geometry (so the truth is exact) while the camera moves.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <iterator>
+
 #include <opencv2/imgproc.hpp>
 
 #include "alvio/camera/camera_model.h"
@@ -87,6 +90,33 @@ TEST(LineTrackTruth, CountsEdgeSwitchesAndTrackLengths) {
   EXPECT_EQ(s.type3_merged, 5u);
   EXPECT_EQ(s.type4_clipped, 1u);
   EXPECT_NEAR(s.mean_ms, 2.0, 1e-9);
+}
+
+TEST(LineTrackTruth, EndpointErrorBinnedBySegmentLength) {
+  const ProjectedEdges truth = {edge(1, {0, 0}, {400, 0})};
+  LineTrackTruth score;
+  LineFrame f;
+  f.lines.push_back(obs(1, {0, 0.5}, {50, 1.5}));    // 50 px: endpoints 0.5 and 1.5 px off
+  f.lines.push_back(obs(2, {0, -0.2}, {250, 0.2}));  // 250 px: 0.2 and 0.2
+  f.lines.push_back(obs(3, {0, 0.1}, {350, -0.3}));  // 350 px, the open bin: 0.1 and 0.3
+  f.lines.push_back(obs(4, {0, 20}, {100, 20}));     // on no edge: not counted
+  score.addFrame(f, truth);
+  const LineTrackTruthSummary s = score.summarise();
+  const std::size_t bins = std::size(LineTrackTruth::kEndpointBinEdgesPx);
+  ASSERT_EQ(s.endpoint_error_by_length.size(), bins);
+  const EndpointErrorBin& shortest = s.endpoint_error_by_length.front();
+  EXPECT_EQ(shortest.min_length_px, 0);
+  EXPECT_EQ(shortest.max_length_px, 60);
+  EXPECT_EQ(shortest.endpoints, 2u);
+  // Distances to the true line, not to the segment's own: 50 px with a 1 px rise is a tilt.
+  EXPECT_NEAR(shortest.rms_px, std::sqrt((0.25 + 2.25) / 2), 1e-9);
+  EXPECT_EQ(s.endpoint_error_by_length[1].endpoints, 0u);
+  EXPECT_EQ(s.endpoint_error_by_length[4].endpoints, 2u);  // [200, 300)
+  EXPECT_NEAR(s.endpoint_error_by_length[4].rms_px, 0.2, 1e-9);
+  const EndpointErrorBin& longest = s.endpoint_error_by_length.back();
+  EXPECT_EQ(longest.min_length_px, 300);
+  EXPECT_TRUE(std::isinf(longest.max_length_px));
+  EXPECT_NEAR(longest.rms_px, std::sqrt((0.01 + 0.09) / 2), 1e-9);
 }
 
 namespace {

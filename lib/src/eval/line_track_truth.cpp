@@ -1,6 +1,9 @@
 #include "alvio/eval/line_track_truth.h"
 
 #include <algorithm>
+#include <cmath>
+#include <iterator>
+#include <limits>
 
 namespace alvio {
 
@@ -11,13 +14,34 @@ double median(std::vector<double> v) {
   std::nth_element(v.begin(), v.begin() + mid, v.end());
   return v[mid];
 }
+
+constexpr std::size_t kBins = std::size(LineTrackTruth::kEndpointBinEdgesPx);
+
+std::size_t lengthBin(double length_px) {
+  std::size_t bin = 0;
+  while (bin + 1 < kBins && length_px >= LineTrackTruth::kEndpointBinEdgesPx[bin + 1]) ++bin;
+  return bin;
+}
+
+const ProjectedEdge* findEdge(const ProjectedEdges& edges, int id) {
+  for (const ProjectedEdge& e : edges)
+    if (e.edge_id == id) return &e;
+  return nullptr;
+}
 }  // namespace
 
 void LineTrackTruth::addFrame(const LineFrame& frame, const ProjectedEdges& truth) {
   for (const LineObservation& o : frame.lines) {
     const EdgeAssociation a = associateWithEdge(LineSegment(o.start_px, o.end_px), truth, options_);
     tracks_[o.id].push_back({a.edge_id, a.compatible});
-    if (a.edge_id >= 0) endpoint_px_.push_back(a.endpoint_distance_px);
+    if (a.edge_id < 0) continue;
+    endpoint_px_.push_back(a.endpoint_distance_px);
+    const ProjectedEdge* edge = findEdge(truth, a.edge_id);
+    if (endpoint_by_length_px_.empty()) endpoint_by_length_px_.resize(kBins);
+    std::vector<double>& bin = endpoint_by_length_px_[lengthBin((o.end_px - o.start_px).norm())];
+    const LineSegment true_line(edge->a, edge->b);
+    bin.push_back(true_line.distanceToLine(o.start_px));
+    bin.push_back(true_line.distanceToLine(o.end_px));
   }
   // The first frame has nothing to associate with: its time is not a tracking time.
   if (frames_ > 0)
@@ -77,6 +101,19 @@ LineTrackTruthSummary LineTrackTruth::summarise() const {
   if (s.evaluated_tracks > 0)
     s.single_edge_track_fraction = static_cast<double>(single_edge) / s.evaluated_tracks;
   s.median_endpoint_distance_px = median(endpoint_px_);
+  for (std::size_t b = 0; b < endpoint_by_length_px_.size(); ++b) {
+    const std::vector<double>& d = endpoint_by_length_px_[b];
+    EndpointErrorBin bin;
+    bin.min_length_px = kEndpointBinEdgesPx[b];
+    bin.max_length_px =
+        b + 1 < kBins ? kEndpointBinEdgesPx[b + 1] : std::numeric_limits<double>::infinity();
+    bin.endpoints = d.size();
+    double squares = 0;
+    for (double x : d) squares += x * x;
+    if (!d.empty()) bin.rms_px = std::sqrt(squares / d.size());
+    bin.median_px = median(d);
+    s.endpoint_error_by_length.push_back(bin);
+  }
   for (double ms : frame_ms_) s.mean_ms += ms / frame_ms_.size();
   s.median_ms = median(frame_ms_);
   return s;
