@@ -35,7 +35,7 @@ bool reconstructStructure(int num_frames, int ref, const Eigen::Matrix3d& R_ref_
                           SfmResult* result);
 
 /// Pose of a camera from 3D points (reference frame) and their normalised observations,
-/// refined from an initial guess. False with fewer than 10 points or on failure.
+/// refined from an initial guess. False with fewer than 6 points or on failure.
 bool cameraPoseFromPoints(const std::vector<Eigen::Vector3d>& points,
                           const std::vector<Eigen::Vector2d>& observations,
                           Eigen::Matrix3d* R_ref_c, Eigen::Vector3d* t_ref_c);
