@@ -501,8 +501,11 @@ class MainTest(unittest.TestCase):
 
     @unittest.skipUnless({0, 1} <= os.sched_getaffinity(0), "needs cores 0 and 1")
     def test_side_by_side_runs_each_pair_at_once_on_swapped_cores(self):
+        # Each stand-in run takes 1 s: a pair started together overlaps even when one of them
+        # takes a few tenths of a second longer to start (0.35 s seen on a loaded machine,
+        # where 0.3 s runs missed each other).
         p = self.bench("--sequences", "sim_A", "--compare", "points", "lines", "--repeats", "4",
-                       "--side-by-side", sleep=0.3)
+                       "--side-by-side", sleep=1.0)
         self.assertEqual(p.returncode, 0, p.stderr)
         out = self.dir / "out" / "sim_A"
         ran = {(v, k): json.loads((out / v / f"r{k}" / "ran.json").read_text())
