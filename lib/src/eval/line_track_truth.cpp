@@ -22,12 +22,6 @@ std::size_t lengthBin(double length_px) {
   while (bin + 1 < kBins && length_px >= LineTrackTruth::kEndpointBinEdgesPx[bin + 1]) ++bin;
   return bin;
 }
-
-const ProjectedEdge* findEdge(const ProjectedEdges& edges, int id) {
-  for (const ProjectedEdge& e : edges)
-    if (e.edge_id == id) return &e;
-  return nullptr;
-}
 }  // namespace
 
 void LineTrackTruth::addFrame(const LineFrame& frame, const ProjectedEdges& truth) {
@@ -36,12 +30,10 @@ void LineTrackTruth::addFrame(const LineFrame& frame, const ProjectedEdges& trut
     tracks_[o.id].push_back({a.edge_id, a.compatible});
     if (a.edge_id < 0) continue;
     endpoint_px_.push_back(a.endpoint_distance_px);
-    const ProjectedEdge* edge = findEdge(truth, a.edge_id);
     if (endpoint_by_length_px_.empty()) endpoint_by_length_px_.resize(kBins);
     std::vector<double>& bin = endpoint_by_length_px_[lengthBin((o.end_px - o.start_px).norm())];
-    const LineSegment true_line(edge->a, edge->b);
-    bin.push_back(true_line.distanceToLine(o.start_px));
-    bin.push_back(true_line.distanceToLine(o.end_px));
+    bin.push_back(a.start_distance_px);
+    bin.push_back(a.end_distance_px);
   }
   // The first frame has nothing to associate with: its time is not a tracking time.
   if (frames_ > 0)

@@ -15,7 +15,9 @@ EdgeAssociation associateWithEdge(const LineSegment& segment, const ProjectedEdg
   for (const ProjectedEdge& e : edges) {
     const LineSegment edge(e.a, e.b);
     if (!(edge.length() > 0)) continue;
-    const double d = std::max(edge.distanceToLine(segment.start), edge.distanceToLine(segment.end));
+    const double d_start = edge.distanceToLine(segment.start);
+    const double d_end = edge.distanceToLine(segment.end);
+    const double d = std::max(d_start, d_end);
     if (d > options.max_endpoint_distance_px) continue;
     // Undirected: an edge has no preferred orientation, LSD's comes from the gradient.
     const double diff = angleDifference(segment.angle(), edge.angle());
@@ -27,6 +29,8 @@ EdgeAssociation associateWithEdge(const LineSegment& segment, const ProjectedEdg
       best = d;
       out.edge_id = e.edge_id;
       out.endpoint_distance_px = d;
+      out.start_distance_px = d_start;
+      out.end_distance_px = d_end;
       out.angle_deg = angle * 180.0 / M_PI;
     }
   }

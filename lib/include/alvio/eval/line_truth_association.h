@@ -31,7 +31,9 @@ struct EdgeAssociation {
   /// The compatible edge with the smallest worst endpoint distance, -1 when none.
   int edge_id = -1;
   double endpoint_distance_px = 0;  ///< the larger of the two, for edge_id
-  double angle_deg = 0;             ///< for edge_id
+  /// Each endpoint's distance to edge_id's image line.
+  double start_distance_px = 0, end_distance_px = 0;
+  double angle_deg = 0;  ///< for edge_id
   /// Every edge within the tolerances (nearly coincident edges make more than one: e.g. the
   /// front and back border of a thin panel seen edge-on).
   std::vector<int> compatible;
