@@ -338,7 +338,7 @@ bool Estimator::detectFailure(std::string* why) const {
 
 void Estimator::reset(double t, const std::string& why) {
   ++reset_count_;
-  logWarn("estimator failure at t=", t, ": ", why, "; resetting and re-initialising");
+  logWarn("estimator failure at t=", stampText(t), ": ", why, "; resetting and re-initialising");
   event(EstimatorEvent::Kind::kFailure, t, why);
   // Keep the latest biases: they are still the best guess after a reset.
   const Eigen::Vector3d ba = Bas_[W_], bg = Bgs_[W_];

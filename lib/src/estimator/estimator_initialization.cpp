@@ -223,7 +223,8 @@ bool Estimator::alignWithImu(double t) {
   std::vector<Eigen::Vector3d> P(Ps_.begin(), Ps_.end());
   std::vector<Eigen::Matrix3d> R(Rs_.begin(), Rs_.end());
   points_.triangulate(P, R, T_b_c_);
-  logInfo("initialised at t=", t, ": scale ", s, ", gyroscope bias ", result.gyro_bias.transpose());
+  logInfo("initialised at t=", stampText(t), ": scale ", s, ", gyroscope bias ",
+          result.gyro_bias.transpose());
   return true;
 }
 

@@ -4,6 +4,7 @@
 // so the core never needs to know who is listening.
 
 #include <functional>
+#include <iomanip>
 #include <sstream>
 #include <string>
 
@@ -24,6 +25,14 @@ void setLogLevel(LogLevel level);
 LogLevel logLevel();
 void logMessage(LogLevel level, const std::string& message);
 const char* logLevelName(LogLevel level);
+
+/// A timestamp in seconds as log text, to the millisecond. A stream's default of six
+/// significant digits prints every time since 2001 as 1.6e+09 or so.
+inline std::string stampText(double t_s) {
+  std::ostringstream os;
+  os << std::fixed << std::setprecision(3) << t_s;
+  return os.str();
+}
 
 namespace detail {
 template <typename... Args>
