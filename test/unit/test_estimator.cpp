@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <set>
+#include <string>
 
 #include "alvio/common/logging.h"
 #include "alvio/config/config.h"
@@ -21,6 +23,7 @@ struct RunOutcome {
   LineSegments3 retired;  // left the window during the run, refined over their tracks
   int resets = 0;
   std::optional<InitializationQuality> init;
+  std::set<std::string> line_schur_structures;  // Ceres's eliminators in solves with lines
 };
 
 // `blackout` (seconds from start, [begin, end)) removes the features from those frames:
@@ -59,6 +62,9 @@ RunOutcome runEstimator(const test::SyntheticScenario& s, const Config& c,
                 << estimator.lines().usableCount() << " residuals "
                 << estimator.lastOptimizationStats().line_residuals << " segments "
                 << estimator.lineSegments().size() << "\n";
+    const OptimizationStats& stats = estimator.lastOptimizationStats();
+    if (stats.line_residuals > 0 && !stats.schur_structure.empty())
+      out.line_schur_structures.insert(stats.schur_structure);
     for (const auto& l : estimator.takeRetiredLines()) out.retired.push_back(l);
     for (const auto& e : estimator.takeEvents())
       if (e.kind == EstimatorEvent::Kind::kInitialized && !out.init) {
@@ -227,6 +233,11 @@ TEST(Estimator, TriangulatesAndOptimisesLines) {
   ASSERT_FALSE(r.trajectory.empty());
   EXPECT_TRUE(filtered.trajectory.back().p == r.trajectory.back().p);
   EXPECT_EQ(r.resets, 0);
+  // Every residual on a landmark has two rows (the lines' damping in two halves), so Ceres
+  // eliminates the landmarks with its kernels for 2-row residuals, not its all-dynamic ones.
+  ASSERT_GT(c.estimator.line_step_damping, 0.0);
+  ASSERT_FALSE(r.line_schur_structures.empty());
+  for (const std::string& s : r.line_schur_structures) EXPECT_EQ(s.rfind("2,", 0), 0u) << s;
   ASSERT_GE(r.lines.size(), 10u);
   ASSERT_GE(r.retired.size(), 30u);
   const EvaluationResult e =

@@ -1,6 +1,6 @@
 // LineStepDampingFactor: zero where the solve started, the manifold's difference near the log
-// map's cut, analytic Jacobians against central differences, and what it is for: a line that
-// one view leaves free no longer takes a wild Gauss-Newton step.
+// map's cut, analytic Jacobians against central differences, its two 2-row halves, and what it
+// is for: a line that one view leaves free no longer takes a wild Gauss-Newton step.
 #include <gtest/gtest.h>
 
 #include <ceres/problem.h>
@@ -68,6 +68,32 @@ TEST(LineStepDampingFactor, AnalyticJacobianMatchesNumeric) {
     const Eigen::MatrixXd J_num = numericJacobian(
         [&](const Eigen::VectorXd& p) -> Eigen::VectorXd { return evaluate(f, p.data()); }, x);
     EXPECT_LT((J_num - J).norm(), 1e-6 * (1.0 + J_num.norm())) << "\n" << J << "\n" << J_num;
+  }
+}
+
+TEST(LineStepDampingFactor, TwoHalvesAreTheFullFactorsRowsExactly) {
+  const double start[4] = {0.9, -1.4, 0.6, 0.2};
+  const double x[4] = {1.1, -1.2, 0.3, 0.5};
+  const double* params[1] = {x};
+  const LineStepDampingFactor full(start, 7.0);
+  Eigen::Vector4d r;
+  Eigen::Matrix<double, 4, 4, Eigen::RowMajor> J;
+  double* jacobians[1] = {J.data()};
+  ASSERT_TRUE(full.Evaluate(params, r.data(), jacobians));
+  ASSERT_GT(r.norm(), 1.0);
+  for (int half : {0, 1}) {
+    const LineStepDampingHalfFactor f(start, 7.0, half);
+    EXPECT_EQ(f.num_residuals(), 2);
+    Eigen::Vector2d r_half;
+    Eigen::Matrix<double, 2, 4, Eigen::RowMajor> J_half;
+    double* half_jacobians[1] = {J_half.data()};
+    ASSERT_TRUE(f.Evaluate(params, r_half.data(), half_jacobians));
+    EXPECT_TRUE(r_half == r.segment<2>(2 * half)) << half;
+    EXPECT_TRUE(J_half == J.middleRows<2>(2 * half)) << half;
+    // Without Jacobians too.
+    Eigen::Vector2d r_only;
+    ASSERT_TRUE(f.Evaluate(params, r_only.data(), nullptr));
+    EXPECT_TRUE(r_only == r_half);
   }
 }
 

@@ -243,8 +243,10 @@ void Estimator::optimize(FrameTiming* timing, int max_iterations) {
         problem.AddResidualBlock(newLineFactor(obs), loss.get(), para_pose_[slot.at(ns)].data(),
                                  line_block);
       if (options_.line_step_damping > 0)
-        problem.AddResidualBlock(new LineStepDampingFactor(line_block, options_.line_step_damping),
-                                 nullptr, line_block);
+        for (int half : {0, 1})
+          problem.AddResidualBlock(
+              new LineStepDampingHalfFactor(line_block, options_.line_step_damping, half), nullptr,
+              line_block);
     }
   }
 
@@ -263,6 +265,7 @@ void Estimator::optimize(FrameTiming* timing, int max_iterations) {
   stats_.solver_ms = 1e3 * summary.total_time_in_seconds;
   stats_.linear_solver_ms = 1e3 * summary.linear_solver_time_in_seconds;
   stats_.jacobian_ms = 1e3 * summary.jacobian_evaluation_time_in_seconds;
+  stats_.schur_structure = summary.schur_structure_used;
   parametersToStates();
   removeReprojectionOutliers();
   if (options_.use_lines) {

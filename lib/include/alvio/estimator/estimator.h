@@ -87,6 +87,9 @@ struct OptimizationStats {
   int unsuccessful_steps = 0;  ///< iterations whose step Ceres rejected (the cost rose)
   /// Ceres's own clock for the solve: total, and its linear solver and Jacobian parts.
   double solver_ms = 0, linear_solver_ms = 0, jacobian_ms = 0;
+  /// The Schur eliminator Ceres used, as residual rows, landmark size, pose size ("2,d,d";
+  /// "d,d,d" is its slowest, all-dynamic one).
+  std::string schur_structure;
 };
 
 /// Something a user should know about: initialisation, a reset, why it waits.

@@ -31,4 +31,20 @@ bool LineStepDampingFactor::Evaluate(double const* const* parameters, double* re
   return true;
 }
 
+LineStepDampingHalfFactor::LineStepDampingHalfFactor(const double* start, double weight, int half)
+    : full_(start, weight), first_row_(2 * half) {}
+
+bool LineStepDampingHalfFactor::Evaluate(double const* const* parameters, double* residuals,
+                                         double** jacobians) const {
+  double r[4];
+  double J[16];
+  double* full_jacobians[1] = {J};
+  if (!full_.Evaluate(parameters, r, jacobians && jacobians[0] ? full_jacobians : nullptr))
+    return false;
+  std::copy(r + first_row_, r + first_row_ + 2, residuals);
+  if (jacobians && jacobians[0])
+    std::copy(J + 4 * first_row_, J + 4 * (first_row_ + 2), jacobians[0]);
+  return true;
+}
+
 }  // namespace alvio

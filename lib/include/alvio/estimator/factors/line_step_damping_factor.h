@@ -31,4 +31,21 @@ class LineStepDampingFactor final : public ceres::SizedCostFunction<4, 4> {
   double weight_;
 };
 
+/// The same term as two residual blocks of two rows each (`half` 0: rows 0-1, 1: rows 2-3),
+/// which together cost exactly what the 4-row block costs. Ceres picks a Schur eliminator
+/// specialised on the residuals' row count only when every residual on an eliminated block has
+/// the same count. The point and line factors have 2 rows; with a 4-row damping block on the
+/// lines the solve fell back to its all-dynamic kernels.
+class LineStepDampingHalfFactor final : public ceres::SizedCostFunction<2, 4> {
+ public:
+  LineStepDampingHalfFactor(const double* start, double weight, int half);
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override;
+
+ private:
+  LineStepDampingFactor full_;
+  int first_row_;
+};
+
 }  // namespace alvio
