@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <random>
+#include <stdexcept>
 
 #include "alvio/estimator/factors/line_step_damping_factor.h"
 #include "alvio/geometry/line_projection_factor.h"
@@ -95,6 +96,7 @@ TEST(LineStepDampingFactor, TwoHalvesAreTheFullFactorsRowsExactly) {
     ASSERT_TRUE(f.Evaluate(params, r_only.data(), nullptr));
     EXPECT_TRUE(r_only == r_half);
   }
+  EXPECT_THROW(LineStepDampingHalfFactor(start, 7.0, 2), std::invalid_argument);
 }
 
 TEST(LineStepDampingFactor, BoundsTheStepOfALineOneViewLeavesFree) {

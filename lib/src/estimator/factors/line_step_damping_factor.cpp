@@ -2,6 +2,8 @@
 
 #include <Eigen/Core>
 #include <algorithm>
+#include <stdexcept>
+#include <string>
 
 #include "alvio/geometry/orthonormal_line_manifold.h"
 #include "alvio/geometry/so3_utils.h"
@@ -32,7 +34,11 @@ bool LineStepDampingFactor::Evaluate(double const* const* parameters, double* re
 }
 
 LineStepDampingHalfFactor::LineStepDampingHalfFactor(const double* start, double weight, int half)
-    : full_(start, weight), first_row_(2 * half) {}
+    : full_(start, weight), first_row_(2 * half) {
+  if (half != 0 && half != 1)
+    throw std::invalid_argument("LineStepDampingHalfFactor: half must be 0 or 1, not " +
+                                std::to_string(half));
+}
 
 bool LineStepDampingHalfFactor::Evaluate(double const* const* parameters, double* residuals,
                                          double** jacobians) const {
