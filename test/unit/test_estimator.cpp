@@ -24,6 +24,7 @@ struct RunOutcome {
   int resets = 0;
   std::optional<InitializationQuality> init;
   std::set<std::string> line_schur_structures;  // Ceres's eliminators in solves with lines
+  std::vector<OptimizationStats> first_solves;   // of the first three frames solved
 };
 
 // `blackout` (seconds from start, [begin, end)) removes the features from those frames:
@@ -63,6 +64,7 @@ RunOutcome runEstimator(const test::SyntheticScenario& s, const Config& c,
                 << estimator.lastOptimizationStats().line_residuals << " segments "
                 << estimator.lineSegments().size() << "\n";
     const OptimizationStats& stats = estimator.lastOptimizationStats();
+    if (stats.iterations > 0 && out.first_solves.size() < 3) out.first_solves.push_back(stats);
     if (stats.line_residuals > 0 && !stats.schur_structure.empty())
       out.line_schur_structures.insert(stats.schur_structure);
     for (const auto& l : estimator.takeRetiredLines()) out.retired.push_back(l);
@@ -208,6 +210,24 @@ TEST(Estimator, InitialisesWithEighteenPointsInView) {
   const EvaluationResult e =
       evaluateTrajectory(r.trajectory, scenario.groundTruth(), EvaluationOptions());
   EXPECT_LT(e.ate_translation_m.rmse, 0.1);
+}
+
+// The initial refinement solves the aligned window with points only, so that no line takes
+// the linear alignment's scale error as its start (a line keeps its first triangulation, and
+// its damping pulls it back there): the demo's clock jump locked the re-initialised window at
+// a third of its scale that way. The lines already tracked join at the next frame.
+TEST(Estimator, LinesJoinAfterTheInitialRefinement) {
+  const Config c = Config::load(test::sourcePath("config/euroc.yaml"));
+  ASSERT_TRUE(c.estimator.use_lines);
+  test::ScenarioOptions so;
+  so.duration_s = 5;
+  const test::SyntheticScenario scenario(so, c.camera, c.imu);
+  const RunOutcome r = runEstimator(scenario, c);
+  ASSERT_EQ(r.first_solves.size(), 3u);
+  EXPECT_GE(r.first_solves[0].points_used, 20);
+  EXPECT_EQ(r.first_solves[0].lines_tracked, 0);
+  EXPECT_EQ(r.first_solves[0].line_residuals, 0);
+  EXPECT_GE(r.first_solves[1].lines_used, 10);
 }
 
 // Lines: triangulated in the window, optimised, and refined over their whole track when

@@ -246,7 +246,10 @@ bool Estimator::addFrame(const FeatureFrame& frame, FrameTiming* timing) {
     status_ = EstimatorStatus::kTracking;
     // Initialisation ends with a first visual-inertial optimisation of the aligned window,
     // given more iterations than the per-frame ones: the linear alignment is only a start.
-    optimize(timing, options_.init_max_iterations);
+    // Lines join from the next frame on. A line keeps its first triangulation as each solve's
+    // start, and its step damping pulls it back there: lines placed from the alignment's
+    // poses would carry the alignment's scale error for as long as they stay.
+    optimize(timing, options_.init_max_iterations, /*triangulate_lines=*/false);
     // A window with too little excitation can align to a wrong gravity; the refinement then
     // pushes the error into the accelerometer bias. Reject such an initialisation and wait.
     if (Bas_[W_].norm() > options_.init_max_accel_bias || !Ps_[W_].allFinite()) {

@@ -165,13 +165,14 @@ void Estimator::parametersToStates() {
   // (docs/benchmarks.md, seventh session).
 }
 
-void Estimator::optimize(FrameTiming* timing, int max_iterations) {
+void Estimator::optimize(FrameTiming* timing, int max_iterations, bool triangulate_lines) {
   {
     ScopedStage stage(timing, "triangulation");
     std::vector<Eigen::Vector3d> P(Ps_.begin(), Ps_.end());
     std::vector<Eigen::Matrix3d> R(Rs_.begin(), Rs_.end());
     points_.triangulate(P, R, T_b_c_);
-    if (options_.use_lines) lines_.triangulate([this](int64_t ns) { return cameraPose(ns); });
+    if (options_.use_lines && triangulate_lines)
+      lines_.triangulate([this](int64_t ns) { return cameraPose(ns); });
   }
   ScopedStage stage(timing, "optimization");
   updateWeights();

@@ -173,7 +173,9 @@ class Estimator {
   ImuNoise imuNoise() const;
 
   // estimator_optimization.cpp
-  void optimize(FrameTiming* timing, int max_iterations);
+  /// One solve of the window. With `triangulate_lines` false, lines not yet placed stay out
+  /// of it (the initial refinement: see addFrame()).
+  void optimize(FrameTiming* timing, int max_iterations, bool triangulate_lines = true);
   void statesToParameters();
   void parametersToStates();
   void marginalize();
