@@ -141,6 +141,23 @@ TEST(Estimator, HoldsOutputUntilTheScaleSettles) {
             << "), settled at " << s.init->time << " s (" << s.init->scale_error << ")\n";
 }
 
+// A solve that takes no step leaves the window where it was, which says nothing about its
+// scale: with no iteration a frame after the initial refinement, the output waits the whole
+// init_settle_max_s instead of starting at the next frame.
+TEST(Estimator, ASolveThatTakesNoStepDoesNotEndTheSettling) {
+  Config stepless = Config::load(test::sourcePath("config/euroc.yaml"));
+  stepless.estimator.max_iterations = 0;
+  ASSERT_GT(stepless.estimator.init_settle_max_s, 0.5);
+  Config at_once = stepless;
+  at_once.estimator.init_settle_max_s = 0;
+  test::ScenarioOptions so;
+  so.duration_s = 8;
+  const test::SyntheticScenario scenario(so, stepless.camera, stepless.imu);
+  const RunOutcome a = runEstimator(scenario, at_once), s = runEstimator(scenario, stepless);
+  ASSERT_TRUE(a.init && s.init);
+  EXPECT_GE(s.init->time, a.init->time + stepless.estimator.init_settle_max_s - 1e-6);
+}
+
 // Losing every feature resets the estimator; it re-initialises and the output
 // continues from the IMU-dead-reckoned pose (no jump to a new world frame).
 TEST(Estimator, ResetsOnTrackingLossAndKeepsOutputContinuous) {

@@ -282,8 +282,10 @@ bool Estimator::addFrame(const FeatureFrame& frame, FrameTiming* timing) {
       return false;
     }
     if (settling_) {
-      if (windowScaleChange() <= options_.init_settle_change ||
-          t - settle_start_ >= options_.init_settle_max_s) {
+      // A solve that took no step left the window where it was: no sign that it has settled.
+      const bool settled =
+          stats_.accepted_steps > 0 && windowScaleChange() <= options_.init_settle_change;
+      if (settled || t - settle_start_ >= options_.init_settle_max_s) {
         settling_ = false;
         initialized(t);
       } else {

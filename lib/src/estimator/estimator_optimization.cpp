@@ -263,6 +263,8 @@ void Estimator::optimize(FrameTiming* timing, int max_iterations, bool triangula
   ceres::Solve(options, &problem, &summary);
   stats_.iterations = static_cast<int>(summary.iterations.size());
   stats_.unsuccessful_steps = summary.num_unsuccessful_steps;
+  // Ceres counts the starting point as a successful iteration 0.
+  stats_.accepted_steps = std::max(0, summary.num_successful_steps - 1);
   stats_.solver_ms = 1e3 * summary.total_time_in_seconds;
   stats_.linear_solver_ms = 1e3 * summary.linear_solver_time_in_seconds;
   stats_.jacobian_ms = 1e3 * summary.jacobian_evaluation_time_in_seconds;

@@ -85,6 +85,7 @@ struct OptimizationStats {
   double w_p = 0.5, w_l = 0.5, alpha = 1.0, M_p = 0, M_l = 0;
   int iterations = 0;
   int unsuccessful_steps = 0;  ///< iterations whose step Ceres rejected (the cost rose)
+  int accepted_steps = 0;      ///< iterations whose step Ceres took
   /// Ceres's own clock for the solve: total, and its linear solver and Jacobian parts.
   double solver_ms = 0, linear_solver_ms = 0, jacobian_ms = 0;
   /// The Schur eliminator Ceres used, as residual rows, landmark size, pose size ("2,d,d";
