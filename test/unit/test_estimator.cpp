@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <set>
 #include <string>
+#include <utility>
 
 #include "alvio/common/logging.h"
 #include "alvio/config/config.h"
@@ -24,7 +25,7 @@ struct RunOutcome {
   int resets = 0;
   std::optional<InitializationQuality> init;
   std::set<std::string> line_schur_structures;  // Ceres's eliminators in solves with lines
-  std::vector<OptimizationStats> first_solves;   // of the first three frames solved
+  std::vector<OptimizationStats> first_solves;  // of the first three frames solved
 };
 
 // `blackout` (seconds from start, [begin, end)) removes the features from those frames:
@@ -78,6 +79,16 @@ RunOutcome runEstimator(const test::SyntheticScenario& s, const Config& c,
   out.lines = estimator.lineSegments();
   return out;
 }
+
+// The same 8 s scenario run with output at once (init_settle_max_s 0), then as configured.
+std::pair<RunOutcome, RunOutcome> runWithoutAndWithSettling(const Config& settling) {
+  Config at_once = settling;
+  at_once.estimator.init_settle_max_s = 0;
+  test::ScenarioOptions so;
+  so.duration_s = 8;
+  const test::SyntheticScenario scenario(so, settling.camera, settling.imu);
+  return {runEstimator(scenario, at_once), runEstimator(scenario, settling)};
+}
 }  // namespace
 
 TEST(Estimator, InitialisesAndTracksSyntheticFeatures) {
@@ -120,14 +131,9 @@ TEST(Estimator, IsDeterministic) {
 // the one of the kInitialized event, at most init_settle_max_s after the alignment (which is
 // when the output starts with settling off).
 TEST(Estimator, HoldsOutputUntilTheScaleSettles) {
-  Config settling = Config::load(test::sourcePath("config/euroc.yaml"));
+  const Config settling = Config::load(test::sourcePath("config/euroc.yaml"));
   ASSERT_GT(settling.estimator.init_settle_max_s, 0);
-  Config at_once = settling;
-  at_once.estimator.init_settle_max_s = 0;
-  test::ScenarioOptions so;
-  so.duration_s = 8;
-  const test::SyntheticScenario scenario(so, settling.camera, settling.imu);
-  const RunOutcome a = runEstimator(scenario, at_once), s = runEstimator(scenario, settling);
+  const auto [a, s] = runWithoutAndWithSettling(settling);
   ASSERT_TRUE(a.init && s.init);
   ASSERT_FALSE(a.trajectory.empty());
   ASSERT_FALSE(s.trajectory.empty());
@@ -148,12 +154,7 @@ TEST(Estimator, ASolveThatTakesNoStepDoesNotEndTheSettling) {
   Config stepless = Config::load(test::sourcePath("config/euroc.yaml"));
   stepless.estimator.max_iterations = 0;
   ASSERT_GT(stepless.estimator.init_settle_max_s, 0.5);
-  Config at_once = stepless;
-  at_once.estimator.init_settle_max_s = 0;
-  test::ScenarioOptions so;
-  so.duration_s = 8;
-  const test::SyntheticScenario scenario(so, stepless.camera, stepless.imu);
-  const RunOutcome a = runEstimator(scenario, at_once), s = runEstimator(scenario, stepless);
+  const auto [a, s] = runWithoutAndWithSettling(stepless);
   ASSERT_TRUE(a.init && s.init);
   EXPECT_GE(s.init->time, a.init->time + stepless.estimator.init_settle_max_s - 1e-6);
 }

@@ -6,6 +6,7 @@
 #include <ceres/solver.h>
 
 #include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
 
 #include "alvio/common/logging.h"
