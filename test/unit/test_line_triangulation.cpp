@@ -356,3 +356,23 @@ TEST(LineQuality, MidpointUncertaintyGrowsWithDepthAndFallsWithBaseline) {
   // Views all from one place: the depth is unobservable.
   EXPECT_GT(stdAt(1, 1e-6), 1e3 * base);
 }
+
+TEST(LineQuality, UncertaintyScalesExactlyWithTheLineNoise) {
+  // config/euroc.yaml halves line_sigma_px and line_map_max_midpoint_std_m together, on the
+  // ground that the map filter then keeps the same lines: halving the noise must halve both
+  // standard deviations to the last bit.
+  std::mt19937 rng(3);
+  LineViews views;
+  for (int i = 0; i < 6; ++i) {
+    const Eigen::Vector3d position(0.04 * i, 0.3 - 0.05 * i, -0.4 + 0.1 * i);
+    views.push_back(observe(lookAt(position, 0.5 * (kP + kQ)), kP, kQ, 0, 1, 0, rng));
+  }
+  const PluckerLine line = PluckerLine::fromPoints(kP, kQ);
+  const LineUncertainty wide = lineUncertainty(line, 0.5 * (kP + kQ), views, 1.5 / 458.654);
+  const LineUncertainty narrow = lineUncertainty(line, 0.5 * (kP + kQ), views, 0.75 / 458.654);
+  ASSERT_GT(wide.midpoint_std_m, 0);
+  EXPECT_EQ(narrow.midpoint_std_m, 0.5 * wide.midpoint_std_m);
+  EXPECT_EQ(narrow.direction_std_deg, 0.5 * wide.direction_std_deg);
+  EXPECT_EQ(lineDirectionStdDeg(line, views, 0.75 / 458.654),
+            0.5 * lineDirectionStdDeg(line, views, 1.5 / 458.654));
+}
