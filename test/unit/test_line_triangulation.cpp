@@ -357,10 +357,10 @@ TEST(LineQuality, MidpointUncertaintyGrowsWithDepthAndFallsWithBaseline) {
   EXPECT_GT(stdAt(1, 1e-6), 1e3 * base);
 }
 
-TEST(LineQuality, UncertaintyScalesExactlyWithTheLineNoise) {
-  // config/euroc.yaml halves line_sigma_px and line_map_max_midpoint_std_m together, on the
-  // ground that the map filter then keeps the same lines: halving the noise must halve both
-  // standard deviations to the last bit.
+TEST(LineQuality, UncertaintyScalesWithTheLineNoise) {
+  // config/euroc.yaml divides line_sigma_px and line_map_max_midpoint_std_m by the same factor,
+  // on the ground that the map filter then keeps the same lines: the standard deviations must
+  // follow the noise to rounding (and to the last bit for a power of two).
   std::mt19937 rng(3);
   LineViews views;
   for (int i = 0; i < 6; ++i) {
@@ -368,11 +368,17 @@ TEST(LineQuality, UncertaintyScalesExactlyWithTheLineNoise) {
     views.push_back(observe(lookAt(position, 0.5 * (kP + kQ)), kP, kQ, 0, 1, 0, rng));
   }
   const PluckerLine line = PluckerLine::fromPoints(kP, kQ);
-  const LineUncertainty wide = lineUncertainty(line, 0.5 * (kP + kQ), views, 1.5 / 458.654);
-  const LineUncertainty narrow = lineUncertainty(line, 0.5 * (kP + kQ), views, 0.75 / 458.654);
-  ASSERT_GT(wide.midpoint_std_m, 0);
-  EXPECT_EQ(narrow.midpoint_std_m, 0.5 * wide.midpoint_std_m);
-  EXPECT_EQ(narrow.direction_std_deg, 0.5 * wide.direction_std_deg);
-  EXPECT_EQ(lineDirectionStdDeg(line, views, 0.75 / 458.654),
-            0.5 * lineDirectionStdDeg(line, views, 1.5 / 458.654));
+  const Eigen::Vector3d mid = 0.5 * (kP + kQ);
+  const double f = 458.654;
+  const LineUncertainty tuned = lineUncertainty(line, mid, views, 1.5 / f);
+  ASSERT_GT(tuned.midpoint_std_m, 0);
+  const LineUncertainty half = lineUncertainty(line, mid, views, 0.75 / f);
+  EXPECT_EQ(half.midpoint_std_m, 0.5 * tuned.midpoint_std_m);
+  EXPECT_EQ(half.direction_std_deg, 0.5 * tuned.direction_std_deg);
+  const LineUncertainty third = lineUncertainty(line, mid, views, 0.5 / f);
+  EXPECT_NEAR(third.midpoint_std_m, tuned.midpoint_std_m / 3, 1e-12 * tuned.midpoint_std_m);
+  EXPECT_NEAR(third.direction_std_deg, tuned.direction_std_deg / 3,
+              1e-12 * tuned.direction_std_deg);
+  EXPECT_NEAR(lineDirectionStdDeg(line, views, 0.5 / f), tuned.direction_std_deg / 3,
+              1e-12 * tuned.direction_std_deg);
 }

@@ -35,7 +35,7 @@ struct EstimatorOptions {
 
   // Lines.
   bool use_lines = true;          ///< line landmarks in the optimisation
-  double line_sigma_px = 0.75;    ///< endpoint-to-line noise of line observations [px]
+  double line_sigma_px = 0.5;     ///< endpoint-to-line noise of line observations [px]
   int line_min_observations = 3;  ///< window observations before a line is used
   double line_outlier_px = 5.0;   ///< lines with a larger mean endpoint error are removed
   /// Square root of the information [1/rad] pulling each line back to where the solve
@@ -52,7 +52,7 @@ struct EstimatorOptions {
   double line_map_min_parallax = 0.10;
   /// Largest 1-sigma uncertainty of a map line's midpoint across the line [m], from its whole
   /// track at line_sigma_px with the poses taken as exact (<= 0: no limit).
-  double line_map_max_midpoint_std_m = 0.015;
+  double line_map_max_midpoint_std_m = 0.01;
 
   /// Sensitivity-based selection and adaptive weighting (estimator.selection).
   FeatureSelectionOptions selection;
