@@ -106,6 +106,19 @@ TEST(Config, LineMapFilterIsReadAndANegativeParallaxIsRejected) {
                         {"estimator.line_map_min_parallax", "must not be negative"});
 }
 
+TEST(Config, LineNoisesAreReadApartAndANonPositiveMapNoiseIsRejected) {
+  const Config c = Config::load(test::sourcePath("config/euroc.yaml"));
+  EXPECT_DOUBLE_EQ(c.estimator.line_sigma_px, 0.35);
+  EXPECT_DOUBLE_EQ(c.estimator.line_map_sigma_px, 1.5);
+  EXPECT_DOUBLE_EQ(c.estimator.line_map_max_midpoint_std_m, 0.03);
+  const std::string dir = test::scratchDir();
+  const std::string path =
+      test::writeFile(dir + "/map_noise.yaml",
+                      eurocYamlReplacing("line_map_sigma_px: 1.5", "line_map_sigma_px: 0"));
+  expectErrorMentioning([&] { Config::load(path); },
+                        {"estimator.line_map_sigma_px", "must be positive"});
+}
+
 TEST(Config, LineStepDampingIsReadAndANegativeOneIsRejected) {
   const Config c = Config::load(test::sourcePath("config/euroc.yaml"));
   EXPECT_EQ(c.estimator.line_step_damping, 10.0);
@@ -317,7 +330,7 @@ TEST(ConfigBase, ReadYamlMergesTheBaseForOtherSections) {
   EXPECT_EQ(Config::load(yaml).camera.distortion_model, "radial-tangential");
 }
 
-TEST(ConfigBase, ShippedRealImuConfigIsEurocWithInFlightImuNoiseAndUndampedLines) {
+TEST(ConfigBase, ShippedRealImuConfigIsEurocWithInFlightImuNoiseUndampedLinesAndTheirOwnNoise) {
   const Config euroc = Config::load(test::sourcePath("config/euroc.yaml"));
   const Config real = Config::load(test::sourcePath("config/euroc_real.yaml"));
   EXPECT_DOUBLE_EQ(real.estimator.imu_noise.accelerometer_noise_density, 0.06);
@@ -329,6 +342,12 @@ TEST(ConfigBase, ShippedRealImuConfigIsEurocWithInFlightImuNoiseAndUndampedLines
   // The lines' step damping helps with the synthetic IMU and costs accuracy with the real one.
   EXPECT_DOUBLE_EQ(euroc.estimator.line_step_damping, 10.0);
   EXPECT_DOUBLE_EQ(real.estimator.line_step_damping, 0.0);
+  // So does a lower line noise; the map lines' uncertainty is computed alike in both.
+  EXPECT_DOUBLE_EQ(euroc.estimator.line_sigma_px, 0.35);
+  EXPECT_DOUBLE_EQ(real.estimator.line_sigma_px, 0.5);
+  EXPECT_DOUBLE_EQ(real.estimator.line_map_sigma_px, euroc.estimator.line_map_sigma_px);
+  EXPECT_DOUBLE_EQ(real.estimator.line_map_max_midpoint_std_m,
+                   euroc.estimator.line_map_max_midpoint_std_m);
 }
 
 TEST(PackageFiles, AnInstalledProgramReadsItsInstalledConfigNotTheSourceTree) {

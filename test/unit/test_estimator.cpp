@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <map>
 #include <set>
 #include <string>
 #include <utility>
@@ -246,6 +247,49 @@ TEST(Estimator, LinesJoinAfterTheInitialRefinement) {
   EXPECT_EQ(r.first_solves[0].lines_tracked, 0);
   EXPECT_EQ(r.first_solves[0].line_residuals, 0);
   EXPECT_GE(r.first_solves[1].lines_used, 10);
+}
+
+// The lines' uncertainties (what the map filters cut on) come from line_map_sigma_px alone:
+// they follow it exactly without moving the trajectory, and tuning the residuals' weight
+// line_sigma_px leaves them where they were, so the map limits need no retuning with it.
+TEST(Estimator, LineUncertaintyFollowsTheMapNoiseNotTheResidualWeight) {
+  Config c = Config::load(test::sourcePath("config/euroc.yaml"));
+  c.estimator.line_map_max_rms_px = 0;
+  c.estimator.line_map_min_parallax = 0;
+  c.estimator.line_map_max_midpoint_std_m = 0;
+  test::ScenarioOptions so;
+  so.duration_s = 8;
+  const test::SyntheticScenario scenario(so, c.camera, c.imu);
+  const RunOutcome base = runEstimator(scenario, c);
+  Config map_noise = c;
+  map_noise.estimator.line_map_sigma_px *= 2;
+  const RunOutcome doubled = runEstimator(scenario, map_noise);
+  Config weight = c;
+  weight.estimator.line_sigma_px *= 2;
+  const RunOutcome reweighted = runEstimator(scenario, weight);
+
+  ASSERT_GE(base.retired.size(), 10u);
+  ASSERT_EQ(doubled.trajectory.size(), base.trajectory.size());
+  EXPECT_TRUE(doubled.trajectory.back().p == base.trajectory.back().p);
+  ASSERT_EQ(doubled.retired.size(), base.retired.size());
+  for (std::size_t i = 0; i < base.retired.size(); ++i) {
+    EXPECT_EQ(doubled.retired[i].midpoint_std_m, 2 * base.retired[i].midpoint_std_m);
+    EXPECT_EQ(doubled.retired[i].direction_std_deg, 2 * base.retired[i].direction_std_deg);
+  }
+  // Reweighted, the poses move a little, and the same tracks' uncertainties with them; had
+  // the weight set the uncertainty, they would all have doubled.
+  std::map<int, double> base_std;
+  for (const auto& l : base.retired) base_std[l.id] = l.midpoint_std_m;
+  std::vector<double> ratios;
+  for (const auto& l : reweighted.retired)
+    if (base_std.count(l.id)) ratios.push_back(l.midpoint_std_m / base_std[l.id]);
+  ASSERT_GE(ratios.size(), 10u);
+  std::sort(ratios.begin(), ratios.end());
+  const double median_ratio = ratios[ratios.size() / 2];
+  std::cout << ratios.size() << " common retired lines, median midpoint-std ratio " << median_ratio
+            << " at twice the residual noise\n";
+  EXPECT_GT(median_ratio, 0.8);
+  EXPECT_LT(median_ratio, 1.25);
 }
 
 // Lines: triangulated in the window, optimised, and refined over their whole track when

@@ -358,9 +358,9 @@ TEST(LineQuality, MidpointUncertaintyGrowsWithDepthAndFallsWithBaseline) {
 }
 
 TEST(LineQuality, UncertaintyScalesWithTheLineNoise) {
-  // config/euroc.yaml divides line_sigma_px and line_map_max_midpoint_std_m by the same factor,
-  // on the ground that the map filter then keeps the same lines: the standard deviations must
-  // follow the noise to rounding (and to the last bit for a power of two).
+  // The map limits (estimator.line_map_max_midpoint_std_m, mapping.max_line_direction_std_deg)
+  // were tuned at one line_map_sigma_px; they carry to another by the same factor only if the
+  // standard deviations follow the noise to rounding (and to the last bit for a power of two).
   std::mt19937 rng(3);
   LineViews views;
   for (int i = 0; i < 6; ++i) {

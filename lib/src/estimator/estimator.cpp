@@ -24,7 +24,7 @@ Estimator::Estimator(const EstimatorOptions& options, const CameraOptions& camer
       lines_(options.line_min_observations, options.line_triangulation),
       para_pose_(options.window_size + 1),
       para_speed_bias_(options.window_size + 1) {
-  lines_.setObservationSigma(options.line_sigma_px / camera.intrinsics[0]);
+  lines_.setUncertaintySigma(options.line_map_sigma_px / camera.intrinsics[0]);
   LineRetirementFilter filter;
   if (options.line_map_max_rms_px > 0)
     filter.max_reprojection_rms = options.line_map_max_rms_px / camera.intrinsics[0];

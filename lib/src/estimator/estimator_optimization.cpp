@@ -426,7 +426,7 @@ void Estimator::removeLineOutliers() {
 }
 
 void Estimator::updateLineUncertainty() {
-  const double sigma = options_.line_sigma_px / camera_.intrinsics[0];
+  const double sigma = options_.line_map_sigma_px / camera_.intrinsics[0];
   for (auto& [id, l] : lines_.landmarks()) {
     if (!lines_.usable(l)) continue;
     LineViews views;

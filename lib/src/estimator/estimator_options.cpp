@@ -42,6 +42,7 @@ EstimatorOptions EstimatorOptions::load(const YamlReader& yaml, const std::strin
   o.line_map_min_parallax = yaml.getDouble(p + "line_map_min_parallax", o.line_map_min_parallax);
   o.line_map_max_edge_rms_px =
       yaml.getDouble(p + "line_map_max_edge_rms_px", o.line_map_max_edge_rms_px);
+  o.line_map_sigma_px = yaml.getDouble(p + "line_map_sigma_px", o.line_map_sigma_px);
   o.line_map_max_midpoint_std_m =
       yaml.getDouble(p + "line_map_max_midpoint_std_m", o.line_map_max_midpoint_std_m);
   o.selection = FeatureSelectionOptions::load(yaml, p + "selection");
@@ -77,6 +78,8 @@ EstimatorOptions EstimatorOptions::load(const YamlReader& yaml, const std::strin
   if (o.point_drift_px2_per_s < 0)
     throw Error(yaml.where(p + "point_drift_px2_per_s") + " must not be negative (0: no drift)");
   if (o.line_sigma_px <= 0) throw Error(yaml.where(p + "line_sigma_px") + " must be positive");
+  if (o.line_map_sigma_px <= 0)
+    throw Error(yaml.where(p + "line_map_sigma_px") + " must be positive");
   if (o.line_min_observations < 2)
     throw Error(yaml.where(p + "line_min_observations") + " must be at least 2");
   if (o.line_step_damping < 0)

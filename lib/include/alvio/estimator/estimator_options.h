@@ -35,7 +35,7 @@ struct EstimatorOptions {
 
   // Lines.
   bool use_lines = true;          ///< line landmarks in the optimisation
-  double line_sigma_px = 0.5;     ///< endpoint-to-line noise of line observations [px]
+  double line_sigma_px = 0.35;    ///< endpoint-to-line noise weighing the line residuals [px]
   int line_min_observations = 3;  ///< window observations before a line is used
   double line_outlier_px = 5.0;   ///< lines with a larger mean endpoint error are removed
   /// Square root of the information [1/rad] pulling each line back to where the solve
@@ -50,9 +50,13 @@ struct EstimatorOptions {
   /// The RMS limit for a track fitted on its full-resolution edge positions (lines.map_edges).
   double line_map_max_edge_rms_px = 0.35;
   double line_map_min_parallax = 0.10;
+  /// Endpoint noise [px] behind the lines' uncertainties (midpoint and direction standard
+  /// deviations), which the map filters cut on. Kept apart from line_sigma_px, a weight tuned
+  /// for the trajectory, so that tuning it leaves the maps alone.
+  double line_map_sigma_px = 1.5;
   /// Largest 1-sigma uncertainty of a map line's midpoint across the line [m], from its whole
-  /// track at line_sigma_px with the poses taken as exact (<= 0: no limit).
-  double line_map_max_midpoint_std_m = 0.01;
+  /// track at line_map_sigma_px with the poses taken as exact (<= 0: no limit).
+  double line_map_max_midpoint_std_m = 0.03;
 
   /// Sensitivity-based selection and adaptive weighting (estimator.selection).
   FeatureSelectionOptions selection;

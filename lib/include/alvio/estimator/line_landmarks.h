@@ -105,7 +105,8 @@ class LineLandmarks {
   }
   /// Lines retired since the last call, refined over their whole track (world frame).
   std::vector<LineLandmark> takeRetired();
-  void setObservationSigma(double sigma_normalised) { sigma_ = sigma_normalised; }
+  /// Endpoint noise [normalised] at which retired lines' uncertainties are computed.
+  void setUncertaintySigma(double sigma_normalised) { sigma_ = sigma_normalised; }
   void setRetirementFilter(const LineRetirementFilter& filter) { filter_ = filter; }
   /// Since construction (resets included).
   const LineRetirementCounts& retirementCounts() const { return counts_; }
