@@ -342,9 +342,12 @@ TEST(ConfigBase, ShippedRealImuConfigIsEurocWithInFlightImuNoiseUndampedLinesAnd
   // The lines' step damping helps with the synthetic IMU and costs accuracy with the real one.
   EXPECT_DOUBLE_EQ(euroc.estimator.line_step_damping, 10.0);
   EXPECT_DOUBLE_EQ(real.estimator.line_step_damping, 0.0);
-  // So does a lower line noise; the map lines' uncertainty is computed alike in both.
+  // So do a lower line noise and a tighter line outlier limit; the map lines' uncertainty is
+  // computed alike in both.
   EXPECT_DOUBLE_EQ(euroc.estimator.line_sigma_px, 0.35);
   EXPECT_DOUBLE_EQ(real.estimator.line_sigma_px, 0.5);
+  EXPECT_DOUBLE_EQ(euroc.estimator.line_outlier_px, 2.0);
+  EXPECT_DOUBLE_EQ(real.estimator.line_outlier_px, 5.0);
   EXPECT_DOUBLE_EQ(real.estimator.line_map_sigma_px, euroc.estimator.line_map_sigma_px);
   EXPECT_DOUBLE_EQ(real.estimator.line_map_max_midpoint_std_m,
                    euroc.estimator.line_map_max_midpoint_std_m);

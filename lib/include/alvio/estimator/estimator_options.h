@@ -37,7 +37,7 @@ struct EstimatorOptions {
   bool use_lines = true;          ///< line landmarks in the optimisation
   double line_sigma_px = 0.35;    ///< endpoint-to-line noise weighing the line residuals [px]
   int line_min_observations = 3;  ///< window observations before a line is used
-  double line_outlier_px = 5.0;   ///< lines with a larger mean endpoint error are removed
+  double line_outlier_px = 2.0;   ///< lines with a larger mean endpoint error are removed
   /// Square root of the information [1/rad] pulling each line back to where the solve
   /// started it (LineStepDampingFactor); 0: off.
   double line_step_damping = 10.0;
