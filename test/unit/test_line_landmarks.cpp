@@ -274,3 +274,36 @@ TEST(LineLandmarks, TracksWhoseEdgeWasLookedForButRarelyFoundStayOutOfTheMap) {
   EXPECT_EQ(retireWithEdgePositions(4, {}, 0, &counts, true).track_observations, 4);
   EXPECT_EQ(counts.retired, 1);
 }
+
+// lines.map_edges' positions as the estimator's observations (estimator.line_residuals_on_edges):
+// the window's landmark and its triangulation take them, and a frame whose edge was looked for
+// and not found is left out while the track goes on.
+TEST(LineLandmarks, ResidualsOnEdgesTakeTheEdgePositionsAndSkipFramesWhereTheEdgeWasNotFound) {
+  for (const bool on_edges : {false, true}) {
+    LineLandmarks lines(3, LineTriangulationOptions{});
+    lines.setResidualsOnEdges(on_edges);
+    for (int k = 0; k < 8; ++k) {
+      auto obs = observeEdge(k, Eigen::Vector3d(0, 0, 0.03));  // the tracker: 3 cm off
+      obs[0].edge_checked = true;
+      obs[0].on_edge = k != 2 && k != 5;
+      if (obs[0].on_edge) {
+        obs[0].edge_start_norm = projectNormalised(cameraAt(k), kP);
+        obs[0].edge_end_norm = projectNormalised(cameraAt(k), kQ);
+      }
+      lines.addFrame(stamp(k), obs);
+    }
+    lines.triangulate([](int64_t ns) { return cameraAt(static_cast<int>(ns - 1000)); });
+    const LineLandmark& l = lines.landmarks().at(3);
+    ASSERT_TRUE(l.hasLine());
+    EXPECT_EQ(l.observations.size(), on_edges ? 6u : 8u);
+    EXPECT_EQ(l.observations.count(stamp(2)), on_edges ? 0u : 1u);
+    // Distance of the true edge's endpoints from the triangulated line.
+    double off = 0;
+    for (const Eigen::Vector3d& x : {kP, kQ})
+      off = std::max(off, (x - projectOntoLine(l.line_w, x)).norm());
+    if (on_edges)
+      EXPECT_LT(off, 1e-6);
+    else
+      EXPECT_NEAR(off, 0.03, 0.005);
+  }
+}

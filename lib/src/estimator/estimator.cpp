@@ -25,6 +25,7 @@ Estimator::Estimator(const EstimatorOptions& options, const CameraOptions& camer
       para_pose_(options.window_size + 1),
       para_speed_bias_(options.window_size + 1) {
   lines_.setUncertaintySigma(options.line_map_sigma_px / camera.intrinsics[0]);
+  lines_.setResidualsOnEdges(options.line_residuals_on_edges);
   LineRetirementFilter filter;
   if (options.line_map_max_rms_px > 0)
     filter.max_reprojection_rms = options.line_map_max_rms_px / camera.intrinsics[0];

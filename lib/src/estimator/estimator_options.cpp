@@ -43,6 +43,8 @@ EstimatorOptions EstimatorOptions::load(const YamlReader& yaml, const std::strin
   o.line_map_max_edge_rms_px =
       yaml.getDouble(p + "line_map_max_edge_rms_px", o.line_map_max_edge_rms_px);
   o.line_map_sigma_px = yaml.getDouble(p + "line_map_sigma_px", o.line_map_sigma_px);
+  o.line_residuals_on_edges =
+      yaml.getBool(p + "line_residuals_on_edges", o.line_residuals_on_edges);
   o.line_map_max_midpoint_std_m =
       yaml.getDouble(p + "line_map_max_midpoint_std_m", o.line_map_max_midpoint_std_m);
   o.selection = FeatureSelectionOptions::load(yaml, p + "selection");

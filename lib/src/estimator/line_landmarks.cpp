@@ -38,9 +38,12 @@ void LineLandmarks::addFrame(
     const std::vector<LineObservation, Eigen::aligned_allocator<LineObservation>>& lines) {
   last_tracked_ = 0;
   for (const auto& o : lines) {
+    // A track that missed its edge in one frame goes on; only that observation is left out.
+    if (residuals_on_edges_ && o.edge_checked && !o.on_edge) continue;
     LineLandmarkObservation obs;
-    obs.start_norm = o.start_norm;
-    obs.end_norm = o.end_norm;
+    const bool take_edge = residuals_on_edges_ && o.on_edge;
+    obs.start_norm = take_edge ? o.edge_start_norm : o.start_norm;
+    obs.end_norm = take_edge ? o.edge_end_norm : o.end_norm;
     obs.edge_checked = o.edge_checked;
     obs.on_edge = o.on_edge;
     obs.edge_start_norm = o.edge_start_norm;

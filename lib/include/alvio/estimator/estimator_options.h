@@ -38,6 +38,10 @@ struct EstimatorOptions {
   double line_sigma_px = 0.35;    ///< endpoint-to-line noise weighing the line residuals [px]
   int line_min_observations = 3;  ///< window observations before a line is used
   double line_outlier_px = 2.0;   ///< lines with a larger mean endpoint error are removed
+  /// The residuals and triangulation take each line observation's full-resolution edge
+  /// position (lines.map_edges) instead of the tracker's, and leave out observations whose
+  /// edge was looked for and not found (the track goes on).
+  bool line_residuals_on_edges = false;
   /// Square root of the information [1/rad] pulling each line back to where the solve
   /// started it (LineStepDampingFactor); 0: off.
   double line_step_damping = 10.0;

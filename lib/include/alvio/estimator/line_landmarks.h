@@ -108,6 +108,9 @@ class LineLandmarks {
   /// Endpoint noise [normalised] at which retired lines' uncertainties are computed.
   void setUncertaintySigma(double sigma_normalised) { sigma_ = sigma_normalised; }
   void setRetirementFilter(const LineRetirementFilter& filter) { filter_ = filter; }
+  /// Take observations at their full-resolution edge positions (EstimatorOptions::
+  /// line_residuals_on_edges).
+  void setResidualsOnEdges(bool on) { residuals_on_edges_ = on; }
   /// Since construction (resets included).
   const LineRetirementCounts& retirementCounts() const { return counts_; }
 
@@ -131,6 +134,7 @@ class LineLandmarks {
   std::map<int, TrackHistory> history_;    // by id
   std::vector<LineLandmark> retired_;
   double sigma_ = 1.5 / 458.0;
+  bool residuals_on_edges_ = false;
   LineRetirementFilter filter_;
   LineRetirementCounts counts_;
 };
