@@ -119,6 +119,19 @@ TEST(Config, LineNoisesAreReadApartAndANonPositiveMapNoiseIsRejected) {
                         {"estimator.line_map_sigma_px", "must be positive"});
 }
 
+TEST(Config, LineResidualsOnEdgesIsOffAndReadAsABoolean) {
+  EXPECT_FALSE(
+      Config::load(test::sourcePath("config/euroc.yaml")).estimator.line_residuals_on_edges);
+  const std::string dir = test::scratchDir();
+  const auto load = [&](const std::string& value) {
+    return Config::load(test::writeFile(
+        dir + "/edges.yaml",
+        eurocYamlReplacing("line_residuals_on_edges: false", "line_residuals_on_edges: " + value)));
+  };
+  EXPECT_TRUE(load("true").estimator.line_residuals_on_edges);
+  expectErrorMentioning([&] { load("maybe"); }, {"estimator.line_residuals_on_edges"});
+}
+
 TEST(Config, LineStepDampingIsReadAndANegativeOneIsRejected) {
   const Config c = Config::load(test::sourcePath("config/euroc.yaml"));
   EXPECT_EQ(c.estimator.line_step_damping, 10.0);
