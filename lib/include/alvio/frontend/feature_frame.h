@@ -25,8 +25,8 @@ struct LineObservation {
   Eigen::Vector2d end_norm = Eigen::Vector2d::Zero();
   int track_count = 1;  ///< frames this ID has been observed in, this one included
   /// The segment moved onto its edge in the full-resolution image (lines.map_edges): used by
-  /// the line map's final fit only, the estimator keeps the positions above. `edge_checked`:
-  /// the edge was looked for (found or not).
+  /// the line map's final fit; the estimator keeps the positions above unless
+  /// estimator.line_residuals_on_edges. `edge_checked`: the edge was looked for (found or not).
   bool edge_checked = false;
   bool on_edge = false;
   Eigen::Vector2d edge_start_norm = Eigen::Vector2d::Zero();
