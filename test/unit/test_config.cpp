@@ -59,6 +59,9 @@ TEST(Config, DefaultEurocConfigLoadsWithEurocValues) {
   EXPECT_NEAR(c.camera.T_b_c.linear()(0, 1), -0.999880929698, 1e-6);
   EXPECT_DOUBLE_EQ(c.imu.accelerometer_noise_density, 2.0e-3);
   EXPECT_EQ(c.topics.image, "/cam0/image_raw");
+  // Keyframes every 15 px of parallax (forty-ninth session), also for a config without the key.
+  EXPECT_DOUBLE_EQ(c.estimator.keyframe_parallax_px, 15.0);
+  EXPECT_DOUBLE_EQ(EstimatorOptions{}.keyframe_parallax_px, c.estimator.keyframe_parallax_px);
 }
 
 TEST(Config, MissingKeyNamesFileAndKey) {
@@ -351,6 +354,7 @@ TEST(ConfigBase, ShippedRealImuConfigIsEurocWithInFlightImuNoiseUndampedLinesAnd
   // The sensor block (what the simulator uses) is euroc.yaml's.
   EXPECT_DOUBLE_EQ(real.imu.accelerometer_noise_density, euroc.imu.accelerometer_noise_density);
   EXPECT_EQ(real.estimator.window_size, euroc.estimator.window_size);
+  EXPECT_DOUBLE_EQ(real.estimator.keyframe_parallax_px, euroc.estimator.keyframe_parallax_px);
   EXPECT_DOUBLE_EQ(euroc.estimator.imu_noise.accelerometer_noise_density, 0.0);
   // The lines' step damping helps with the synthetic IMU and costs accuracy with the real one.
   EXPECT_DOUBLE_EQ(euroc.estimator.line_step_damping, 10.0);

@@ -13,7 +13,7 @@ class YamlReader;
 
 struct EstimatorOptions {
   int window_size = 10;                ///< keyframes in the window (plus the newest frame)
-  double keyframe_parallax_px = 10;    ///< mean parallax that makes a frame a keyframe
+  double keyframe_parallax_px = 15;    ///< mean parallax that makes a frame a keyframe [px]
   int max_iterations = 2;              ///< Ceres iterations per frame (no time limit: determinism)
   int init_max_iterations = 24;        ///< ...for the first solve after (re-)initialisation
   int num_threads = 1;                 ///< Ceres threads
