@@ -36,6 +36,17 @@ refuse_during_build() {
 }
 
 refuse_during_build
+# A program older than the core library was not relinked when the library last changed (only
+# other targets were built since), so its idea of the library's types may be out of date: such
+# a frozen alvio_sim crashed at start-up.
+for program in alvio_run alvio_sim; do
+  if [[ "$BUILD/devel/lib/alvio/$program" -ot "$BUILD/devel/lib/libalvio_core.so" ]]; then
+    echo "freeze_build.sh: $BUILD/devel/lib/alvio/$program is older than libalvio_core.so" \
+      "(not rebuilt since the library changed); build all targets (./alvio build), then" \
+      "freeze again" >&2
+    exit 1
+  fi
+done
 mkdir -p "$out/lib" "$out/bin"
 cp -a "$BUILD"/devel/lib/*.so* "$out/lib/"
 cp -a "$BUILD"/devel/lib/alvio/alvio_run "$BUILD"/devel/lib/alvio/alvio_sim "$out/bin/"

@@ -71,6 +71,7 @@ class FreezeBuildTest(unittest.TestCase):
                             str(src / "core.c")], check=True)
 
         build_library(1)
+        (lib / "alvio/alvio_sim").touch()  # linked after the library, as make would
         (src / "run.c").write_text('#include <stdio.h>\nint core_version(void);\n'
                                    'int main(void) { printf("%d", core_version()); return 0; }\n')
         subprocess.run(["gcc", "-o", str(lib / "alvio/alvio_run"), str(src / "run.c"), f"-L{lib}",
@@ -85,6 +86,18 @@ class FreezeBuildTest(unittest.TestCase):
         self.assertEqual(frozen.stdout, "1", frozen.stderr)
         # The stand-in's other files (text, not programs) were copied as they were.
         self.assertEqual((self.out / "bin/alvio_sim").read_text(), "alvio_sim")
+
+    def test_refuses_a_program_older_than_the_core_library(self):
+        # Only the library and alvio_run rebuilt since alvio_sim was linked (make alvio_run).
+        program = self.build / "devel/lib/alvio/alvio_sim"
+        library = self.build / "devel/lib/libalvio_core.so"
+        os.utime(program, (library.stat().st_mtime - 60, library.stat().st_mtime - 60))
+        r = self.freeze()
+        self.assertEqual(r.returncode, 1)
+        self.assertIn(f"{program} is older than libalvio_core.so", r.stderr)
+        self.assertFalse((self.out / "bin").exists())
+        program.touch()
+        self.assertEqual(self.freeze().returncode, 0)
 
     def test_missing_build_names_it(self):
         self.build = Path(self.tmp.name) / "nowhere"
