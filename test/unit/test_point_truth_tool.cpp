@@ -65,18 +65,23 @@ const TruthRun& oracleRun() {
 
 }  // namespace
 
-TEST(PointTruthTool, TrueProjectionsGiveASmallerErrorThanTrackedOnes) {
+TEST(PointTruthTool, TheOracleFeedsTrueProjectionsWhoseNoiseTheEstimatorFeels) {
   const TruthRun tracked = runPointTruth("");
   const TruthRun& oracle = oracleRun();
+  const TruthRun noisy = runPointTruth("--oracle --oracle-noise-px 1.0");
   ASSERT_EQ(tracked.rc, 0) << tracked.output;
   ASSERT_EQ(oracle.rc, 0) << oracle.output;
+  ASSERT_EQ(noisy.rc, 0) << noisy.output;
   ASSERT_GT(tracked.ate, 0) << tracked.output;
   ASSERT_GT(oracle.ate, 0) << oracle.output;
-  // Tracked points lie within a pixel of their true projection; the estimator does better on
-  // the true ones (0.0079 against 0.0045 m when written).
+  // Tracked points lie within a pixel of their true projection (0.15 px median), close enough
+  // that on these 8 s they no longer limit the estimate: tracked and true projections score
+  // 0.0058 and 0.0059 m with keyframes every 15 px (0.0103 and 0.0058 m at 10 px). A pixel of
+  // noise on the true projections costs clearly more (0.0130 m).
   EXPECT_LT(tracked.point_error_px, 1.0);
   EXPECT_LT(tracked.ate, 0.05);
-  EXPECT_LT(oracle.ate, tracked.ate);
+  EXPECT_LT(oracle.ate, noisy.ate);
+  EXPECT_LT(tracked.ate, noisy.ate);
   // Both score the same tracks: the error statistic is of the tracked positions either way.
   EXPECT_DOUBLE_EQ(oracle.point_error_px, tracked.point_error_px);
 }
