@@ -36,12 +36,13 @@ refuse_during_build() {
 }
 
 refuse_during_build
+programs=("$BUILD"/devel/lib/alvio/alvio_run "$BUILD"/devel/lib/alvio/alvio_sim)
 # A program older than the core library was not relinked when the library last changed (only
 # other targets were built since), so its idea of the library's types may be out of date: such
 # a frozen alvio_sim crashed at start-up.
-for program in alvio_run alvio_sim; do
-  if [[ "$BUILD/devel/lib/alvio/$program" -ot "$BUILD/devel/lib/libalvio_core.so" ]]; then
-    echo "freeze_build.sh: $BUILD/devel/lib/alvio/$program is older than libalvio_core.so" \
+for program in "${programs[@]}"; do
+  if [[ "$program" -ot "$BUILD/devel/lib/libalvio_core.so" ]]; then
+    echo "freeze_build.sh: $program is older than libalvio_core.so" \
       "(not rebuilt since the library changed); build all targets (./alvio build), then" \
       "freeze again" >&2
     exit 1
@@ -49,7 +50,7 @@ for program in alvio_run alvio_sim; do
 done
 mkdir -p "$out/lib" "$out/bin"
 cp -a "$BUILD"/devel/lib/*.so* "$out/lib/"
-cp -a "$BUILD"/devel/lib/alvio/alvio_run "$BUILD"/devel/lib/alvio/alvio_sim "$out/bin/"
+cp -a "${programs[@]}" "$out/bin/"
 # The build's RUNPATH names build/devel/lib: without this a frozen program run by hand loads
 # the live libraries, whose types may have changed since (a crash in a destructor).
 is_elf() { [[ "$(head -c 4 "$1" | od -An -c | tr -d ' ')" == '177ELF' ]]; }
