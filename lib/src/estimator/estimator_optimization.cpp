@@ -172,6 +172,10 @@ void Estimator::optimize(FrameTiming* timing, int max_iterations, bool triangula
     std::vector<Eigen::Vector3d> P(Ps_.begin(), Ps_.end());
     std::vector<Eigen::Matrix3d> R(Rs_.begin(), Rs_.end());
     points_.triangulate(P, R, T_b_c_);
+    const FeatureSelectionOptions& sel = options_.selection;
+    if (sel.select_points && sel.refresh_unselected)
+      points_.retriangulate(P, R, T_b_c_,
+                            [this](const PointLandmark& l) { return !pointSelected(l); });
     if (options_.use_lines && triangulate_lines)
       lines_.triangulate([this](int64_t ns) { return cameraPose(ns); });
   }
@@ -331,7 +335,8 @@ void Estimator::marginalize() {
     for (const auto& [id, l] : points_.landmarks()) {
       if (!l.usable(W_)) continue;
       ++index;
-      if (l.start_frame != 0 || !pointSelected(l)) continue;
+      if (l.start_frame != 0) continue;
+      if (!pointSelected(l) && !options_.selection.marginalize_unselected) continue;
       const Eigen::Vector2d obs_i = l.sightings.front().xy1.head<2>();
       for (std::size_t k = 1; k < l.sightings.size(); ++k)
         info->addResidualBlock(
@@ -347,7 +352,8 @@ void Estimator::marginalize() {
       for (const auto& [id, l] : lines_.landmarks()) {
         if (!lines_.usable(l)) continue;
         double* line_block = lineBlock(k++);
-        if (l.observations.begin()->first != header_ns_[0] || !lineSelected(l)) continue;
+        if (l.observations.begin()->first != header_ns_[0]) continue;
+        if (!lineSelected(l) && !options_.selection.marginalize_unselected) continue;
         for (const auto& [ns, obs] : l.observations)
           info->addResidualBlock(newLineFactor(obs), makeLoss(options_),
                                  {para_pose_[slot.at(ns)].data(), line_block}, {1});

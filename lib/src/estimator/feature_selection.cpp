@@ -54,6 +54,8 @@ FeatureSelectionOptions FeatureSelectionOptions::load(const YamlReader& yaml,
   const std::string p = prefix + ".";
   o.select_points = yaml.getBool(p + "points", o.select_points);
   o.select_lines = yaml.getBool(p + "lines", o.select_lines);
+  o.refresh_unselected = yaml.getBool(p + "refresh_unselected", o.refresh_unselected);
+  o.marginalize_unselected = yaml.getBool(p + "marginalize_unselected", o.marginalize_unselected);
   o.surfaces_file = yaml.getString(p + "surfaces_file", o.surfaces_file);
   o.adaptive_weighting = yaml.getBool(p + "adaptive_weighting", o.adaptive_weighting);
   o.alpha_more = yaml.getDouble(p + "alpha_more", o.alpha_more);

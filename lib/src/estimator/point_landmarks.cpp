@@ -56,37 +56,58 @@ std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> PointLandmarks::corresp
   return out;
 }
 
+namespace {
+
+// Depth in the anchor camera by linear triangulation (DLT) over all sightings.
+double dltDepth(const PointLandmark& l, const std::vector<Eigen::Vector3d>& P,
+                const std::vector<Eigen::Matrix3d>& R, const Eigen::Isometry3d& T_b_c) {
+  const Eigen::Matrix3d R_b_c = T_b_c.linear();
+  const Eigen::Vector3d t_b_c = T_b_c.translation();
+  // Camera poses relative to the anchor camera.
+  const int i0 = l.start_frame;
+  const Eigen::Vector3d t0 = P[i0] + R[i0] * t_b_c;
+  const Eigen::Matrix3d R0 = R[i0] * R_b_c;
+  Eigen::MatrixXd A(2 * l.sightings.size(), 4);
+  for (std::size_t k = 0; k < l.sightings.size(); ++k) {
+    const int i = i0 + static_cast<int>(k);
+    const Eigen::Vector3d t1 = P[i] + R[i] * t_b_c;
+    const Eigen::Matrix3d R1 = R[i] * R_b_c;
+    // Pose of anchor-frame points in camera i: x_i = R^T (x_0 - t).
+    const Eigen::Vector3d t = R0.transpose() * (t1 - t0);
+    const Eigen::Matrix3d Rr = R0.transpose() * R1;
+    Eigen::Matrix<double, 3, 4> Pm;
+    Pm.leftCols<3>() = Rr.transpose();
+    Pm.rightCols<1>() = -Rr.transpose() * t;
+    const Eigen::Vector3d f = l.sightings[k].xy1.normalized();
+    A.row(2 * k) = f[0] * Pm.row(2) - f[2] * Pm.row(0);
+    A.row(2 * k + 1) = f[1] * Pm.row(2) - f[2] * Pm.row(1);
+  }
+  const Eigen::Vector4d X =
+      Eigen::JacobiSVD<Eigen::MatrixXd>(A, Eigen::ComputeThinV).matrixV().col(3);
+  return X[2] / X[3];
+}
+
+}  // namespace
+
 void PointLandmarks::triangulate(const std::vector<Eigen::Vector3d>& P,
                                  const std::vector<Eigen::Matrix3d>& R,
                                  const Eigen::Isometry3d& T_b_c) {
-  const Eigen::Matrix3d R_b_c = T_b_c.linear();
-  const Eigen::Vector3d t_b_c = T_b_c.translation();
   for (auto& [id, l] : landmarks_) {
     if (!l.usable(window_size_) || l.depth > 0) continue;
-    // Camera poses relative to the anchor camera; linear triangulation (DLT) over all sightings.
-    const int i0 = l.start_frame;
-    const Eigen::Vector3d t0 = P[i0] + R[i0] * t_b_c;
-    const Eigen::Matrix3d R0 = R[i0] * R_b_c;
-    Eigen::MatrixXd A(2 * l.sightings.size(), 4);
-    for (std::size_t k = 0; k < l.sightings.size(); ++k) {
-      const int i = i0 + static_cast<int>(k);
-      const Eigen::Vector3d t1 = P[i] + R[i] * t_b_c;
-      const Eigen::Matrix3d R1 = R[i] * R_b_c;
-      // Pose of anchor-frame points in camera i: x_i = R^T (x_0 - t).
-      const Eigen::Vector3d t = R0.transpose() * (t1 - t0);
-      const Eigen::Matrix3d Rr = R0.transpose() * R1;
-      Eigen::Matrix<double, 3, 4> Pm;
-      Pm.leftCols<3>() = Rr.transpose();
-      Pm.rightCols<1>() = -Rr.transpose() * t;
-      const Eigen::Vector3d f = l.sightings[k].xy1.normalized();
-      A.row(2 * k) = f[0] * Pm.row(2) - f[2] * Pm.row(0);
-      A.row(2 * k + 1) = f[1] * Pm.row(2) - f[2] * Pm.row(1);
-    }
-    const Eigen::Vector4d X =
-        Eigen::JacobiSVD<Eigen::MatrixXd>(A, Eigen::ComputeThinV).matrixV().col(3);
-    const double depth = X[2] / X[3];
+    const double depth = dltDepth(l, P, R, T_b_c);
     l.depth = depth < 0.1 ? kDefaultDepth : depth;
     l.state = PointLandmark::State::kTriangulated;
+  }
+}
+
+void PointLandmarks::retriangulate(const std::vector<Eigen::Vector3d>& P,
+                                   const std::vector<Eigen::Matrix3d>& R,
+                                   const Eigen::Isometry3d& T_b_c,
+                                   const std::function<bool(const PointLandmark&)>& which) {
+  for (auto& [id, l] : landmarks_) {
+    if (!l.usable(window_size_) || l.depth <= 0 || !which(l)) continue;
+    const double depth = dltDepth(l, P, R, T_b_c);
+    if (depth >= 0.1) l.depth = depth;  // a degenerate solution keeps the last depth
   }
 }
 

@@ -36,6 +36,12 @@ enum class WeightTarget { kResiduals, kCosts };
 struct FeatureSelectionOptions {
   bool select_points = false;  ///< leave points in low-value image regions out
   bool select_lines = false;
+  /// Triangulate the points left out again every frame, so that they keep a depth fit for
+  /// the outlier check and for the solve they join when their anchor moves.
+  bool refresh_unselected = false;
+  /// Fold the points and lines left out into the marginalisation prior when their first
+  /// keyframe leaves.
+  bool marginalize_unselected = false;
   std::string surfaces_file;  ///< selection_surfaces.yaml (alvio analyze); relative to the config
   TrackSurface point_surface, line_surface;  ///< loaded from surfaces_file
   bool adaptive_weighting = true;

@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <functional>
 #include <map>
 #include <vector>
 
@@ -49,6 +50,11 @@ class PointLandmarks {
   /// Poses are body poses in the world; T_b_c the camera extrinsic.
   void triangulate(const std::vector<Eigen::Vector3d>& P, const std::vector<Eigen::Matrix3d>& R,
                    const Eigen::Isometry3d& T_b_c);
+  /// Triangulate again, at the current poses, the usable landmarks with a depth that `which`
+  /// names (those the optimiser leaves out keep a stale depth otherwise).
+  void retriangulate(const std::vector<Eigen::Vector3d>& P, const std::vector<Eigen::Matrix3d>& R,
+                     const Eigen::Isometry3d& T_b_c,
+                     const std::function<bool(const PointLandmark&)>& which);
 
   int usableCount() const;
   /// Inverse depths of usable landmarks in iteration order, and their write-back.
