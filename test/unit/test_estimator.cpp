@@ -249,6 +249,46 @@ TEST(Estimator, LinesJoinAfterTheInitialRefinement) {
   EXPECT_GE(r.first_solves[1].lines_used, 10);
 }
 
+// Selection leaves the points and lines on the image's left half out of the solve. Folded into
+// the marginalisation prior when their first keyframe leaves (and the points kept triangulated
+// meanwhile), they still constrain the trajectory: it must come closer to the one of no
+// selection than when they are dropped altogether.
+TEST(Estimator, FeaturesLeftOutOfTheSolveStillReachThePrior) {
+  Config none = Config::load(test::sourcePath("config/euroc.yaml"));
+  test::ScenarioOptions so;
+  so.duration_s = 15;
+  const test::SyntheticScenario scenario(so, none.camera, none.imu);
+  Config dropped = none;
+  FeatureSelectionOptions& sel = dropped.estimator.selection;
+  sel.select_points = sel.select_lines = true;
+  for (TrackSurface* surface : {&sel.point_surface, &sel.line_surface}) {
+    surface->degree = 1;
+    surface->coefficients = {10, 10, 0};  // 10 + 10 u: at least 10 on the right half
+    surface->min_expected_track = 10;
+  }
+  Config folded = dropped;
+  folded.estimator.selection.refresh_unselected = true;
+  folded.estimator.selection.marginalize_unselected = true;
+  const auto ate = [&](const Config& c, int* points_used) {
+    const RunOutcome r = runEstimator(scenario, c);
+    EXPECT_EQ(r.resets, 0);
+    *points_used = r.first_solves.empty() ? 0 : r.first_solves.back().points_used;
+    return evaluateTrajectory(r.trajectory, scenario.groundTruth(), EvaluationOptions())
+        .ate_translation_m.rmse;
+  };
+  int used_none = 0, used_dropped = 0, used_folded = 0;
+  const double ate_none = ate(none, &used_none);
+  const double ate_dropped = ate(dropped, &used_dropped);
+  const double ate_folded = ate(folded, &used_folded);
+  std::cout << "ATE no selection " << ate_none << " m, left out and dropped " << ate_dropped
+            << " m, left out and folded into the prior " << ate_folded << " m (points in the "
+            << "second solve " << used_none << " / " << used_dropped << " / " << used_folded
+            << ")\n";
+  EXPECT_LT(used_dropped, used_none * 3 / 4);  // the selection does leave points out
+  EXPECT_EQ(used_folded, used_dropped);
+  EXPECT_LT(std::abs(ate_folded - ate_none), std::abs(ate_dropped - ate_none));
+}
+
 // The lines' uncertainties (what the map filters cut on) come from line_map_sigma_px alone:
 // they follow it exactly without moving the trajectory, and tuning the residuals' weight
 // line_sigma_px leaves them where they were, so the map limits need no retuning with it.
