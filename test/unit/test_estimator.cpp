@@ -261,6 +261,7 @@ TEST(Estimator, FeaturesLeftOutOfTheSolveStillReachThePrior) {
   Config dropped = none;
   FeatureSelectionOptions& sel = dropped.estimator.selection;
   sel.select_points = sel.select_lines = true;
+  sel.refresh_unselected = sel.marginalize_unselected = false;  // the paper's selection
   for (TrackSurface* surface : {&sel.point_surface, &sel.line_surface}) {
     surface->degree = 1;
     surface->coefficients = {10, 10, 0};  // 10 + 10 u: at least 10 on the right half

@@ -1,5 +1,6 @@
 #include "alvio/estimator/point_landmarks.h"
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/SVD>
 
 namespace alvio {
@@ -58,16 +59,18 @@ std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> PointLandmarks::corresp
 
 namespace {
 
-// Depth in the anchor camera by linear triangulation (DLT) over all sightings.
-double dltDepth(const PointLandmark& l, const std::vector<Eigen::Vector3d>& P,
-                const std::vector<Eigen::Matrix3d>& R, const Eigen::Isometry3d& T_b_c) {
+// The two DLT rows of each sighting (a_k^T X = 0 for the point X in the anchor camera):
+// row(k, r0, r1) for k over the sightings.
+template <class RowPair>
+void forEachDltRowPair(const PointLandmark& l, const std::vector<Eigen::Vector3d>& P,
+                       const std::vector<Eigen::Matrix3d>& R, const Eigen::Isometry3d& T_b_c,
+                       RowPair&& row) {
   const Eigen::Matrix3d R_b_c = T_b_c.linear();
   const Eigen::Vector3d t_b_c = T_b_c.translation();
   // Camera poses relative to the anchor camera.
   const int i0 = l.start_frame;
   const Eigen::Vector3d t0 = P[i0] + R[i0] * t_b_c;
   const Eigen::Matrix3d R0 = R[i0] * R_b_c;
-  Eigen::MatrixXd A(2 * l.sightings.size(), 4);
   for (std::size_t k = 0; k < l.sightings.size(); ++k) {
     const int i = i0 + static_cast<int>(k);
     const Eigen::Vector3d t1 = P[i] + R[i] * t_b_c;
@@ -79,11 +82,37 @@ double dltDepth(const PointLandmark& l, const std::vector<Eigen::Vector3d>& P,
     Pm.leftCols<3>() = Rr.transpose();
     Pm.rightCols<1>() = -Rr.transpose() * t;
     const Eigen::Vector3d f = l.sightings[k].xy1.normalized();
-    A.row(2 * k) = f[0] * Pm.row(2) - f[2] * Pm.row(0);
-    A.row(2 * k + 1) = f[1] * Pm.row(2) - f[2] * Pm.row(1);
+    row(k, Eigen::RowVector4d(f[0] * Pm.row(2) - f[2] * Pm.row(0)),
+        Eigen::RowVector4d(f[1] * Pm.row(2) - f[2] * Pm.row(1)));
   }
+}
+
+// Depth in the anchor camera by linear triangulation (DLT) over all sightings.
+double dltDepth(const PointLandmark& l, const std::vector<Eigen::Vector3d>& P,
+                const std::vector<Eigen::Matrix3d>& R, const Eigen::Isometry3d& T_b_c) {
+  Eigen::MatrixXd A(2 * l.sightings.size(), 4);
+  forEachDltRowPair(l, P, R, T_b_c,
+                    [&](std::size_t k, const Eigen::RowVector4d& r0, const Eigen::RowVector4d& r1) {
+                      A.row(2 * k) = r0;
+                      A.row(2 * k + 1) = r1;
+                    });
   const Eigen::Vector4d X =
       Eigen::JacobiSVD<Eigen::MatrixXd>(A, Eigen::ComputeThinV).matrixV().col(3);
+  return X[2] / X[3];
+}
+
+// The same least-squares solution from the 4x4 normal matrix A^T A: fixed-size and without
+// allocation, for the points triangulated again on every frame.
+double dltDepthFromNormalMatrix(const PointLandmark& l, const std::vector<Eigen::Vector3d>& P,
+                                const std::vector<Eigen::Matrix3d>& R,
+                                const Eigen::Isometry3d& T_b_c) {
+  Eigen::Matrix4d AtA = Eigen::Matrix4d::Zero();
+  forEachDltRowPair(l, P, R, T_b_c,
+                    [&](std::size_t, const Eigen::RowVector4d& r0, const Eigen::RowVector4d& r1) {
+                      AtA.noalias() += r0.transpose() * r0 + r1.transpose() * r1;
+                    });
+  const Eigen::Vector4d X =
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix4d>(AtA).eigenvectors().col(0);
   return X[2] / X[3];
 }
 
@@ -106,7 +135,7 @@ void PointLandmarks::retriangulate(const std::vector<Eigen::Vector3d>& P,
                                    const std::function<bool(const PointLandmark&)>& which) {
   for (auto& [id, l] : landmarks_) {
     if (!l.usable(window_size_) || l.depth <= 0 || !which(l)) continue;
-    const double depth = dltDepth(l, P, R, T_b_c);
+    const double depth = dltDepthFromNormalMatrix(l, P, R, T_b_c);
     if (depth >= 0.1) l.depth = depth;  // a degenerate solution keeps the last depth
   }
 }

@@ -38,10 +38,10 @@ struct FeatureSelectionOptions {
   bool select_lines = false;
   /// Triangulate the points left out again every frame, so that they keep a depth fit for
   /// the outlier check and for the solve they join when their anchor moves.
-  bool refresh_unselected = false;
+  bool refresh_unselected = true;
   /// Fold the points and lines left out into the marginalisation prior when their first
   /// keyframe leaves.
-  bool marginalize_unselected = false;
+  bool marginalize_unselected = true;
   std::string surfaces_file;  ///< selection_surfaces.yaml (alvio analyze); relative to the config
   TrackSurface point_surface, line_surface;  ///< loaded from surfaces_file
   bool adaptive_weighting = true;
