@@ -47,9 +47,9 @@ namespace {
 
 // A landmark seen by cameras translating along x (identity rotations, camera = body) in
 // frames 0..n-1, with the true point `p` in the world (= frame 0's camera).
-PointLandmark landmarkSeenFromAline(const Eigen::Vector3d& p, int n,
-                                    std::vector<Eigen::Vector3d>* P,
-                                    std::vector<Eigen::Matrix3d>* R) {
+PointLandmark landmarkSeenAlongALine(const Eigen::Vector3d& p, int n,
+                                     std::vector<Eigen::Vector3d>* P,
+                                     std::vector<Eigen::Matrix3d>* R) {
   PointLandmark l;
   for (int i = 0; i < n; ++i) {
     P->push_back(Eigen::Vector3d(0.1 * i, 0, 0));
@@ -67,7 +67,7 @@ PointLandmark landmarkSeenFromAline(const Eigen::Vector3d& p, int n,
 TEST(PointLandmarks, RetriangulateRefreshesOnlyTheNamedLandmarksDepths) {
   std::vector<Eigen::Vector3d> P;
   std::vector<Eigen::Matrix3d> R;
-  const PointLandmark seen = landmarkSeenFromAline(Eigen::Vector3d(0.3, -0.2, 4.0), 5, &P, &R);
+  const PointLandmark seen = landmarkSeenAlongALine(Eigen::Vector3d(0.3, -0.2, 4.0), 5, &P, &R);
   PointLandmarks landmarks(10, kMinParallax);
   for (int id : {1, 2}) {
     PointLandmark l = seen;
@@ -85,7 +85,7 @@ TEST(PointLandmarks, RetriangulateKeepsTheDepthWhenTheSightingsDoNotPlaceThePoin
   std::vector<Eigen::Vector3d> P;
   std::vector<Eigen::Matrix3d> R;
   // All cameras at one place: no parallax, the depth is not observable.
-  PointLandmark l = landmarkSeenFromAline(Eigen::Vector3d(0.3, -0.2, 4.0), 5, &P, &R);
+  PointLandmark l = landmarkSeenAlongALine(Eigen::Vector3d(0.3, -0.2, 4.0), 5, &P, &R);
   for (auto& p : P) p.setZero();
   for (auto& s : l.sightings) s.xy1 = Eigen::Vector3d(0.3 / 4, -0.2 / 4, 1);
   l.id = 1;

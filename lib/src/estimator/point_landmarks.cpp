@@ -7,7 +7,9 @@ namespace alvio {
 
 namespace {
 constexpr double kDefaultDepth = 5.0;  // metres; for landmarks re-anchored behind the camera
-}
+// A DLT depth below this (metres) is degenerate or behind the camera, not a real point.
+constexpr double kMinTriangulatedDepth = 0.1;
+}  // namespace
 
 bool PointLandmarks::addFrameAndCheckParallax(int frame_index, const FeatureFrame& frame) {
   last_track_num_ = 0;
@@ -124,7 +126,7 @@ void PointLandmarks::triangulate(const std::vector<Eigen::Vector3d>& P,
   for (auto& [id, l] : landmarks_) {
     if (!l.usable(window_size_) || l.depth > 0) continue;
     const double depth = dltDepth(l, P, R, T_b_c);
-    l.depth = depth < 0.1 ? kDefaultDepth : depth;
+    l.depth = depth < kMinTriangulatedDepth ? kDefaultDepth : depth;
     l.state = PointLandmark::State::kTriangulated;
   }
 }
@@ -136,7 +138,8 @@ void PointLandmarks::retriangulate(const std::vector<Eigen::Vector3d>& P,
   for (auto& [id, l] : landmarks_) {
     if (!l.usable(window_size_) || l.depth <= 0 || !which(l)) continue;
     const double depth = dltDepthFromNormalMatrix(l, P, R, T_b_c);
-    if (depth >= 0.1) l.depth = depth;  // a degenerate solution keeps the last depth
+    if (depth >= kMinTriangulatedDepth)
+      l.depth = depth;  // a degenerate solution keeps the last depth
   }
 }
 
