@@ -336,7 +336,7 @@ void Estimator::marginalize() {
       if (!l.usable(W_)) continue;
       ++index;
       if (l.start_frame != 0) continue;
-      if (!pointSelected(l) && !options_.selection.marginalize_unselected) continue;
+      if (!options_.selection.marginalize_unselected && !pointSelected(l)) continue;
       const Eigen::Vector2d obs_i = l.sightings.front().xy1.head<2>();
       for (std::size_t k = 1; k < l.sightings.size(); ++k)
         info->addResidualBlock(
@@ -353,7 +353,7 @@ void Estimator::marginalize() {
         if (!lines_.usable(l)) continue;
         double* line_block = lineBlock(k++);
         if (l.observations.begin()->first != header_ns_[0]) continue;
-        if (!lineSelected(l) && !options_.selection.marginalize_unselected) continue;
+        if (!options_.selection.marginalize_unselected && !lineSelected(l)) continue;
         for (const auto& [ns, obs] : l.observations)
           info->addResidualBlock(newLineFactor(obs), makeLoss(options_),
                                  {para_pose_[slot.at(ns)].data(), line_block}, {1});
