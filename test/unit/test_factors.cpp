@@ -201,6 +201,32 @@ TEST(Marginalization, PriorIgnoresQuaternionSign) {
   EXPECT_LT(test::checkJacobians(prior, {pose1, pose2}).max_rel_error, 1e-6);
 }
 
+// A rank-deficient information, at the scale of a window's prior, becomes as many non-zero
+// rows as it has rank, and reproduces the information and gradient.
+TEST(Marginalization, FactorPriorKeepsRankAndInformation) {
+  std::mt19937 gen(7);
+  std::normal_distribution<double> normal;
+  for (int trial = 0; trial < 20; ++trial) {
+    const int n = 69, rank = n - 4 - trial % 3;  // four gauge directions or more
+    Eigen::MatrixXd A(rank, n);
+    for (int i = 0; i < A.size(); ++i) A.data()[i] = 1e3 * normal(gen);
+    const Eigen::MatrixXd H = A.transpose() * A;
+    Eigen::VectorXd r0(rank);
+    for (int i = 0; i < rank; ++i) r0[i] = normal(gen);
+    const Eigen::VectorXd g = A.transpose() * r0;
+    Eigen::MatrixXd J;
+    Eigen::VectorXd r;
+    factorPrior(H, g, &J, &r);
+    ASSERT_EQ(J.rows(), n);
+    EXPECT_EQ((J.rowwise().norm().array() > 0).count(), rank) << "trial " << trial;
+    EXPECT_LT((J.transpose() * J - H).norm() / H.norm(), 1e-10) << "trial " << trial;
+    EXPECT_LT((J.transpose() * r - g).norm() / g.norm(), 1e-8) << "trial " << trial;
+    // |r|^2 = g^T H^+ g is the part of |r0|^2 that the states can explain: no more than
+    // |r0|^2. Noise pivots kept as directions would inflate it.
+    EXPECT_LE(r.norm(), r0.norm() * (1 + 1e-9)) << "trial " << trial;
+  }
+}
+
 // The prior's information equals the dense Schur complement of the full system.
 TEST(Marginalization, PriorEqualsDenseSchurComplement) {
   const Eigen::Isometry3d T_b_c = eurocTbc();
@@ -257,4 +283,11 @@ TEST(Marginalization, PriorEqualsDenseSchurComplement) {
   ASSERT_EQ(info->keptAddresses(), (std::vector<double*>{poses[1], poses[2]}));
   EXPECT_LT((Jp.transpose() * Jp - Hrr).norm() / Hrr.norm(), 1e-8);
   EXPECT_LT((Jp.transpose() * info->linearizedResidual() - gr).norm() / gr.norm(), 1e-8);
+  // Eight residuals leave the kept states' information rank deficient: the prior has one
+  // non-zero row per direction it constrains, and none for the others.
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> kept_es(Hrr);
+  const int rank = static_cast<int>(
+      (kept_es.eigenvalues().array() > 1e-9 * kept_es.eigenvalues().maxCoeff()).count());
+  ASSERT_LT(rank, n);
+  EXPECT_EQ((Jp.rowwise().norm().array() > 0).count(), rank);
 }

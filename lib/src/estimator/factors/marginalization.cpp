@@ -3,6 +3,7 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <unordered_map>
 
 #include "alvio/common/error.h"
@@ -70,7 +71,111 @@ void applyLoss(const ceres::LossFunction& loss, Eigen::VectorXd* r,
   *r *= residual_scaling;
 }
 
+// Pseudo-inverse of a symmetric positive semi-definite matrix (eigenvalues up to 1e-8 count
+// as zero).
+Eigen::MatrixXd symmetricPseudoInverse(const Eigen::MatrixXd& A) {
+  constexpr double kMinEigenvalue = 1e-8;
+  if (A.rows() == 1)  // inverse depths: most of the landmarks
+    return Eigen::MatrixXd::Constant(1, 1, A(0, 0) > kMinEigenvalue ? 1.0 / A(0, 0) : 0.0);
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(0.5 * (A + A.transpose()));
+  const Eigen::VectorXd inv =
+      (es.eigenvalues().array() > kMinEigenvalue).select(es.eigenvalues().array().inverse(), 0.0);
+  return es.eigenvectors() * inv.asDiagonal() * es.eigenvectors().transpose();
+}
+
+// Evaluates a factor at the current values and adds its J^T J and J^T r (tangent space,
+// robust loss applied) to a system, at the blocks' offsets there. The matrices keep their
+// storage from one factor to the next: most factors have the same shapes.
+class FactorLinearizer {
+ public:
+  template <typename OffsetOf>
+  void addTo(const ceres::CostFunction& cost, const ceres::LossFunction* loss,
+             const std::vector<double*>& blocks, OffsetOf offset_of, Eigen::MatrixXd* H,
+             Eigen::VectorXd* g) {
+    const int num_residuals = cost.num_residuals();
+    const auto& sizes = cost.parameter_block_sizes();
+    r_.resize(num_residuals);
+    Ja_.resize(blocks.size());
+    jac_ptrs_.resize(blocks.size());
+    Jt_.resize(blocks.size());
+    for (std::size_t k = 0; k < blocks.size(); ++k) {
+      Ja_[k].resize(num_residuals, sizes[k]);
+      jac_ptrs_[k] = Ja_[k].data();
+    }
+    if (!cost.Evaluate(blocks.data(), r_.data(), jac_ptrs_.data()))
+      throw Error("marginalisation: a factor failed to evaluate");
+    for (std::size_t k = 0; k < blocks.size(); ++k)
+      tangentJacobian(Ja_[k], blocks[k], sizes[k], &Jt_[k]);
+    if (loss) applyLoss(*loss, &r_, &Jt_);
+    for (std::size_t a = 0; a < blocks.size(); ++a) {
+      const int ia = offset_of(blocks[a]);
+      g->segment(ia, Jt_[a].cols()) += Jt_[a].transpose() * r_;
+      for (std::size_t b = a; b < blocks.size(); ++b) {
+        const int ib = offset_of(blocks[b]);
+        Hab_.noalias() = Jt_[a].transpose() * Jt_[b];
+        H->block(ia, ib, Hab_.rows(), Hab_.cols()) += Hab_;
+        if (a != b) H->block(ib, ia, Hab_.cols(), Hab_.rows()) += Hab_.transpose();
+      }
+    }
+  }
+
+ private:
+  Eigen::VectorXd r_;
+  std::vector<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> Ja_;
+  std::vector<double*> jac_ptrs_;
+  std::vector<Eigen::MatrixXd> Jt_;
+  Eigen::MatrixXd Hab_;
+};
+
+// Pivots below this fraction of H's largest diagonal entry are rounding noise. In a window's
+// prior the kept pivots were at least 3e-9 of it, the others at most 6e-12 (median 1e-14 and
+// below; 800 frames each of sim_MH_05 and sim_MH_03_realimu).
+constexpr double kPriorRankTolerance = 1e-10;
+
 }  // namespace
+
+void factorPrior(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, Eigen::MatrixXd* J,
+                 Eigen::VectorXd* r) {
+  const int n = static_cast<int>(H.rows());
+  // Outer-product LDL^T with complete diagonal pivoting (LAPACK's dpstrf): each step takes
+  // the largest diagonal entry of what is left, so the factorisation stops at H's rank.
+  // (Eigen's LDLT pivots on the original diagonal, which does not reveal the rank.)
+  Eigen::MatrixXd A = H;
+  std::vector<int> perm(n);
+  for (int i = 0; i < n; ++i) perm[i] = i;
+  const double tol = std::max(1e-8, kPriorRankTolerance * A.diagonal().maxCoeff());
+  int rank = 0;
+  for (; rank < n; ++rank) {
+    int p;
+    if (A.diagonal().tail(n - rank).maxCoeff(&p) <= tol) break;
+    p += rank;
+    if (p != rank) {
+      A.row(rank).swap(A.row(p));
+      A.col(rank).swap(A.col(p));
+      std::swap(perm[rank], perm[p]);
+    }
+    const int rest = n - rank - 1;
+    const double d = A(rank, rank);
+    A.col(rank).tail(rest) /= d;
+    A.bottomRightCorner(rest, rest).noalias() -=
+        d * A.col(rank).tail(rest) * A.col(rank).tail(rest).transpose();
+  }
+  // H = P^T L D L^T P with L (n x rank) unit lower triangular: J = D^1/2 L^T P.
+  const Eigen::VectorXd sqrt_d = A.diagonal().head(rank).cwiseSqrt();
+  J->setZero(n, n);
+  Eigen::VectorXd pg(n);
+  for (int i = 0; i < n; ++i) {
+    pg[i] = g[perm[i]];
+    for (int k = 0; k < std::min(i, rank); ++k) (*J)(k, perm[i]) = A(i, k) * sqrt_d[k];
+    if (i < rank) (*J)(i, perm[i]) = sqrt_d[i];
+  }
+  // r = D^-1/2 L^-1 P g over the first `rank` rows (g lies in H's range).
+  r->setZero(n);
+  r->head(rank) = A.topLeftCorner(rank, rank)
+                      .triangularView<Eigen::UnitLower>()
+                      .solve(pg.head(rank))
+                      .cwiseQuotient(sqrt_d);
+}
 
 void MarginalizationInfo::addResidualBlock(ceres::CostFunction* cost, ceres::LossFunction* loss,
                                            std::vector<double*> blocks, std::vector<int> drop) {
@@ -83,109 +188,105 @@ void MarginalizationInfo::addResidualBlock(ceres::CostFunction* cost, ceres::Los
 }
 
 bool MarginalizationInfo::marginalize() {
-  // Order the blocks: dropped first, then kept, each with a tangent offset.
   std::unordered_map<double*, int> size_of;
-  std::vector<double*> dropped, kept;
   std::unordered_map<double*, bool> is_dropped;
   for (const auto& f : factors_) {
     const auto& sizes = f.cost->parameter_block_sizes();
     for (std::size_t k = 0; k < f.blocks.size(); ++k) size_of[f.blocks[k]] = sizes[k];
     for (int d : f.drop) is_dropped[f.blocks[d]] = true;
   }
-  for (const auto& f : factors_)
-    for (double* b : f.blocks) {
+  // Dropped landmarks (inverse depths, lines: size 1 or 4) couple only with the states, never
+  // with each other: each is eliminated in a small system of its own factors and the states
+  // they touch. The states (dropped first, then kept) form one dense system.
+  auto isLandmark = [&](double* b) {
+    return is_dropped.count(b) && (size_of[b] == 1 || size_of[b] == 4);
+  };
+  std::vector<double*> dropped, kept, landmarks;
+  std::unordered_map<double*, std::vector<std::size_t>> factors_of;
+  std::vector<std::size_t> state_factors;
+  for (std::size_t i = 0; i < factors_.size(); ++i) {
+    double* landmark = nullptr;
+    for (double* b : factors_[i].blocks) {
+      if (isLandmark(b)) {
+        if (landmark && landmark != b)
+          throw Error("marginalisation: a factor couples two landmarks");
+        landmark = b;
+        continue;
+      }
       auto& list = is_dropped.count(b) ? dropped : kept;
       if (std::find(list.begin(), list.end(), b) == list.end()) list.push_back(b);
     }
-  // Landmark blocks (inverse depths, lines: size 1 or 4) first: they couple only with the
-  // states, never with each other, so they are eliminated one by one below.
-  std::stable_partition(dropped.begin(), dropped.end(),
-                        [&](double* b) { return size_of[b] == 1 || size_of[b] == 4; });
-  std::unordered_map<double*, int> offset;
-  int m = 0, n = 0, m_landmarks = 0;
-  for (double* b : dropped) {
-    offset[b] = m;
-    m += tangentSizeOf(size_of[b]);
-    if (size_of[b] == 1 || size_of[b] == 4) m_landmarks = m;
+    if (!landmark) {
+      state_factors.push_back(i);
+      continue;
+    }
+    auto& of = factors_of[landmark];
+    if (of.empty()) landmarks.push_back(landmark);
+    of.push_back(i);
   }
+  std::unordered_map<double*, int> offset;
+  int m = 0, n = 0;
+  for (double* b : dropped) offset[b] = m, m += tangentSizeOf(size_of[b]);
   for (double* b : kept) offset[b] = m + n, n += tangentSizeOf(size_of[b]);
   if (n == 0) return false;
 
-  // Gauss-Newton system of all factors at the current values. The per-factor matrices keep
-  // their storage from one factor to the next: most factors have the same shapes.
   Eigen::MatrixXd H = Eigen::MatrixXd::Zero(m + n, m + n);
   Eigen::VectorXd g = Eigen::VectorXd::Zero(m + n);
-  Eigen::VectorXd r;
-  std::vector<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> Ja;
-  std::vector<double*> jac_ptrs;
-  std::vector<Eigen::MatrixXd> Jt;
-  Eigen::MatrixXd Hab;
-  for (const auto& f : factors_) {
-    const int num_residuals = f.cost->num_residuals();
-    const auto& sizes = f.cost->parameter_block_sizes();
-    r.resize(num_residuals);
-    Ja.resize(f.blocks.size());
-    jac_ptrs.resize(f.blocks.size());
-    Jt.resize(f.blocks.size());
-    for (std::size_t k = 0; k < f.blocks.size(); ++k) {
-      Ja[k].resize(num_residuals, sizes[k]);
-      jac_ptrs[k] = Ja[k].data();
-    }
-    if (!f.cost->Evaluate(f.blocks.data(), r.data(), jac_ptrs.data()))
-      throw Error("marginalisation: a factor failed to evaluate");
-    for (std::size_t k = 0; k < f.blocks.size(); ++k)
-      tangentJacobian(Ja[k], f.blocks[k], sizes[k], &Jt[k]);
-    if (f.loss) applyLoss(*f.loss, &r, &Jt);
-    for (std::size_t a = 0; a < f.blocks.size(); ++a) {
-      const int ia = offset[f.blocks[a]];
-      g.segment(ia, Jt[a].cols()) += Jt[a].transpose() * r;
-      for (std::size_t b = a; b < f.blocks.size(); ++b) {
-        const int ib = offset[f.blocks[b]];
-        Hab.noalias() = Jt[a].transpose() * Jt[b];
-        H.block(ia, ib, Hab.rows(), Hab.cols()) += Hab;
-        if (a != b) H.block(ib, ia, Hab.cols(), Hab.rows()) += Hab.transpose();
+  FactorLinearizer linearize;
+  for (std::size_t i : state_factors)
+    linearize.addTo(
+        *factors_[i].cost, factors_[i].loss.get(), factors_[i].blocks,
+        [&](double* b) { return offset[b]; }, &H, &g);
+
+  // Each landmark: [landmark, the states its factors touch], the landmark eliminated there.
+  std::unordered_map<double*, int> local_offset;
+  std::vector<double*> touched;
+  Eigen::MatrixXd Hl;
+  Eigen::VectorXd gl;
+  for (double* landmark : landmarks) {
+    const int t = tangentSizeOf(size_of[landmark]);
+    local_offset.clear();
+    touched.clear();
+    local_offset[landmark] = 0;
+    int size = t;
+    for (std::size_t i : factors_of[landmark])
+      for (double* b : factors_[i].blocks)
+        if (local_offset.emplace(b, size).second) {
+          touched.push_back(b);
+          size += tangentSizeOf(size_of[b]);
+        }
+    Hl.setZero(size, size);
+    gl.setZero(size);
+    for (std::size_t i : factors_of[landmark])
+      linearize.addTo(
+          *factors_[i].cost, factors_[i].loss.get(), factors_[i].blocks,
+          [&](double* b) { return local_offset[b]; }, &Hl, &gl);
+    // Pseudo-inverse: a landmark can be unconstrained in some direction.
+    const Eigen::MatrixXd inv = symmetricPseudoInverse(Hl.topLeftCorner(t, t));
+    const int rest = size - t;
+    const Eigen::MatrixXd K = Hl.bottomLeftCorner(rest, t) * inv;
+    Hl.bottomRightCorner(rest, rest).noalias() -= K * Hl.topRightCorner(t, rest);
+    gl.tail(rest).noalias() -= K * gl.head(t);
+    for (double* a : touched) {
+      const int la = local_offset[a], ga = offset[a], ta = tangentSizeOf(size_of[a]);
+      g.segment(ga, ta) += gl.segment(la, ta);
+      for (double* b : touched) {
+        const int lb = local_offset[b], tb = tangentSizeOf(size_of[b]);
+        H.block(ga, offset[b], ta, tb) += Hl.block(la, lb, ta, tb);
       }
     }
   }
 
-  // Schur complement onto the kept states. Landmarks go first, block by block (their blocks
-  // are tiny and mutually independent), then the remaining dropped states densely; both
-  // with pseudo-inverses, as a landmark can be unconstrained in some direction.
-  auto pseudoInverse = [](const Eigen::MatrixXd& A) {
-    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(0.5 * (A + A.transpose()));
-    const Eigen::VectorXd inv =
-        (es.eigenvalues().array() > 1e-8).select(es.eigenvalues().array().inverse(), 0.0);
-    return Eigen::MatrixXd(es.eigenvectors() * inv.asDiagonal() * es.eigenvectors().transpose());
-  };
-  const int total = m + n;
-  for (double* b : dropped) {
-    const int o = offset[b], t = tangentSizeOf(size_of[b]);
-    if (o >= m_landmarks) break;
-    const Eigen::MatrixXd inv = pseudoInverse(H.block(o, o, t, t));
-    const int rest = total - m_landmarks;  // eliminate into the states and kept blocks only
-    const Eigen::MatrixXd Hxl = H.block(m_landmarks, o, rest, t);
-    const Eigen::MatrixXd K = Hxl * inv;
-    H.bottomRightCorner(rest, rest).noalias() -= K * Hxl.transpose();
-    g.tail(rest).noalias() -= K * g.segment(o, t);
-  }
+  // Schur complement onto the kept states.
   Eigen::MatrixXd Hrr = H.bottomRightCorner(n, n);
   Eigen::VectorXd gr = g.tail(n);
-  const int m_states = m - m_landmarks;
-  if (m_states > 0) {
-    const Eigen::MatrixXd Hmm_inv =
-        pseudoInverse(H.block(m_landmarks, m_landmarks, m_states, m_states));
-    const Eigen::MatrixXd Hrm = H.block(m, m_landmarks, n, m_states);
+  if (m > 0) {
+    const Eigen::MatrixXd Hmm_inv = symmetricPseudoInverse(H.topLeftCorner(m, m));
+    const Eigen::MatrixXd Hrm = H.bottomLeftCorner(n, m);
     Hrr -= Hrm * Hmm_inv * Hrm.transpose();
-    gr -= Hrm * Hmm_inv * g.segment(m_landmarks, m_states);
+    gr -= Hrm * Hmm_inv * g.head(m);
   }
-
-  // Factor the prior as |J dx + r|^2: Hrr = J^T J, gr = J^T r.
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(0.5 * (Hrr + Hrr.transpose()));
-  const Eigen::VectorXd S = (es.eigenvalues().array() > 1e-8).select(es.eigenvalues().array(), 0.0);
-  const Eigen::VectorXd S_inv =
-      (es.eigenvalues().array() > 1e-8).select(es.eigenvalues().array().inverse(), 0.0);
-  linearized_jacobian_ = S.cwiseSqrt().asDiagonal() * es.eigenvectors().transpose();
-  linearized_residual_ = S_inv.cwiseSqrt().asDiagonal() * es.eigenvectors().transpose() * gr;
+  factorPrior(0.5 * (Hrr + Hrr.transpose()), gr, &linearized_jacobian_, &linearized_residual_);
 
   kept_addresses_ = kept;
   kept_sizes_.clear();

@@ -67,6 +67,14 @@ class MarginalizationFactor : public ceres::CostFunction {
   std::shared_ptr<const MarginalizationInfo> info_;
 };
 
+/// Writes a Gaussian prior with information H (symmetric, positive semi-definite) and gradient
+/// g (in H's range) as |J dx + r|^2: J^T J = H and J^T r = g. By an LDL^T with complete
+/// diagonal pivoting, H = P^T L D L^T P: J = D^1/2 L^T P, r = D^-1/2 L^-1 P g, at a twentieth
+/// of an eigendecomposition's cost. The pivoting leaves the directions H does not constrain
+/// (the window's position and yaw) last, where D is rounding noise: they become zero rows.
+void factorPrior(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, Eigen::MatrixXd* J,
+                 Eigen::VectorXd* r);
+
 /// Tangent size of a block of ambient size `size` (7 -> 6, else unchanged).
 inline int tangentSizeOf(int size) {
   return size == 7 ? 6 : size;
