@@ -13,15 +13,15 @@
 namespace alvio {
 namespace {
 
-// Tangent-space Jacobian of one block from its ambient (row-major) Jacobian, into `J`
-// (whose storage is reused).
+// Tangent-space Jacobian of one block from its ambient (row-major) Jacobian, into `J`.
+template <typename Columns>
 void tangentJacobian(
     const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>& J_ambient,
-    const double* x, int size, Eigen::MatrixXd* J) {
+    const double* x, int size, Columns&& J) {
   if (size != 7)
-    *J = J_ambient;
+    J = J_ambient;
   else
-    J->noalias() = J_ambient * posePlusJacobian(x);
+    J.noalias() = J_ambient * posePlusJacobian(x);
 }
 
 // Inverse left Jacobian of SO(3) at rotation vector phi: d Log(Exp(e) R) / de at e = 0.
@@ -50,9 +50,8 @@ Eigen::VectorXd tangentDifference(const double* x, const double* x0, int size) {
   return d;
 }
 
-// Robust-loss correction of residual and Jacobians, as Ceres' Corrector does.
-void applyLoss(const ceres::LossFunction& loss, Eigen::VectorXd* r,
-               std::vector<Eigen::MatrixXd>* jacobians) {
+// Robust-loss correction of residual and Jacobian, as Ceres' Corrector does.
+void applyLoss(const ceres::LossFunction& loss, Eigen::VectorXd* r, Eigen::MatrixXd* J) {
   const double sq_norm = r->squaredNorm();
   double rho[3];
   loss.Evaluate(sq_norm, rho);
@@ -67,7 +66,7 @@ void applyLoss(const ceres::LossFunction& loss, Eigen::VectorXd* r,
     residual_scaling = sqrt_rho1 / (1 - alpha);
     alpha_sq_norm = alpha / sq_norm;
   }
-  for (auto& J : *jacobians) J = sqrt_rho1 * (J - alpha_sq_norm * (*r) * (r->transpose() * J));
+  *J = sqrt_rho1 * (*J - alpha_sq_norm * (*r) * (r->transpose() * (*J)));
   *r *= residual_scaling;
 }
 
@@ -97,34 +96,40 @@ class FactorLinearizer {
     r_.resize(num_residuals);
     Ja_.resize(blocks.size());
     jac_ptrs_.resize(blocks.size());
-    Jt_.resize(blocks.size());
+    column_.resize(blocks.size() + 1);
+    column_[0] = 0;
     for (std::size_t k = 0; k < blocks.size(); ++k) {
       Ja_[k].resize(num_residuals, sizes[k]);
       jac_ptrs_[k] = Ja_[k].data();
+      column_[k + 1] = column_[k] + tangentSizeOf(sizes[k]);
     }
     if (!cost.Evaluate(blocks.data(), r_.data(), jac_ptrs_.data()))
       throw Error("marginalisation: a factor failed to evaluate");
+    // All blocks side by side: one product gives every block pair's J_a^T J_b (per pair,
+    // Eigen's matrix product set-up cost more than these few-column products).
+    J_.resize(num_residuals, column_.back());
     for (std::size_t k = 0; k < blocks.size(); ++k)
-      tangentJacobian(Ja_[k], blocks[k], sizes[k], &Jt_[k]);
-    if (loss) applyLoss(*loss, &r_, &Jt_);
+      tangentJacobian(Ja_[k], blocks[k], sizes[k],
+                      J_.middleCols(column_[k], column_[k + 1] - column_[k]));
+    if (loss) applyLoss(*loss, &r_, &J_);
+    JtJ_.noalias() = J_.transpose() * J_;
+    Jtr_.noalias() = J_.transpose() * r_;
     for (std::size_t a = 0; a < blocks.size(); ++a) {
-      const int ia = offset_of(blocks[a]);
-      g->segment(ia, Jt_[a].cols()) += Jt_[a].transpose() * r_;
-      for (std::size_t b = a; b < blocks.size(); ++b) {
-        const int ib = offset_of(blocks[b]);
-        Hab_.noalias() = Jt_[a].transpose() * Jt_[b];
-        H->block(ia, ib, Hab_.rows(), Hab_.cols()) += Hab_;
-        if (a != b) H->block(ib, ia, Hab_.cols(), Hab_.rows()) += Hab_.transpose();
+      const int ia = offset_of(blocks[a]), ta = column_[a + 1] - column_[a];
+      g->segment(ia, ta) += Jtr_.segment(column_[a], ta);
+      for (std::size_t b = 0; b < blocks.size(); ++b) {
+        const int tb = column_[b + 1] - column_[b];
+        H->block(ia, offset_of(blocks[b]), ta, tb) += JtJ_.block(column_[a], column_[b], ta, tb);
       }
     }
   }
 
  private:
-  Eigen::VectorXd r_;
+  Eigen::VectorXd r_, Jtr_;
   std::vector<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> Ja_;
   std::vector<double*> jac_ptrs_;
-  std::vector<Eigen::MatrixXd> Jt_;
-  Eigen::MatrixXd Hab_;
+  std::vector<int> column_;
+  Eigen::MatrixXd J_, JtJ_;
 };
 
 // Pivots below this fraction of H's largest diagonal entry are rounding noise. In a window's
@@ -239,40 +244,50 @@ bool MarginalizationInfo::marginalize() {
         [&](double* b) { return offset[b]; }, &H, &g);
 
   // Each landmark: [landmark, the states its factors touch], the landmark eliminated there.
-  std::unordered_map<double*, int> local_offset;
-  std::vector<double*> touched;
-  Eigen::MatrixXd Hl;
+  // A landmark touches a dozen blocks at most: a list finds them faster than a hash map.
+  struct LocalBlock {
+    double* address;
+    int local_offset, offset, tangent_size;
+  };
+  std::vector<LocalBlock> local;
+  auto localOffset = [&](double* b) {
+    for (const LocalBlock& l : local)
+      if (l.address == b) return l.local_offset;
+    return -1;
+  };
+  Eigen::MatrixXd Hl, K;
   Eigen::VectorXd gl;
   for (double* landmark : landmarks) {
     const int t = tangentSizeOf(size_of[landmark]);
-    local_offset.clear();
-    touched.clear();
-    local_offset[landmark] = 0;
+    local.assign(1, {landmark, 0, -1, t});
     int size = t;
     for (std::size_t i : factors_of[landmark])
       for (double* b : factors_[i].blocks)
-        if (local_offset.emplace(b, size).second) {
-          touched.push_back(b);
-          size += tangentSizeOf(size_of[b]);
+        if (localOffset(b) < 0) {
+          const int tb = tangentSizeOf(size_of[b]);
+          local.push_back({b, size, offset[b], tb});
+          size += tb;
         }
     Hl.setZero(size, size);
     gl.setZero(size);
     for (std::size_t i : factors_of[landmark])
-      linearize.addTo(
-          *factors_[i].cost, factors_[i].loss.get(), factors_[i].blocks,
-          [&](double* b) { return local_offset[b]; }, &Hl, &gl);
+      linearize.addTo(*factors_[i].cost, factors_[i].loss.get(), factors_[i].blocks, localOffset,
+                      &Hl, &gl);
     // Pseudo-inverse: a landmark can be unconstrained in some direction.
     const Eigen::MatrixXd inv = symmetricPseudoInverse(Hl.topLeftCorner(t, t));
     const int rest = size - t;
-    const Eigen::MatrixXd K = Hl.bottomLeftCorner(rest, t) * inv;
-    Hl.bottomRightCorner(rest, rest).noalias() -= K * Hl.topRightCorner(t, rest);
+    K.noalias() = Hl.bottomLeftCorner(rest, t) * inv;
+    // Column by column: outer products of vectors, cheaper than a matrix product this thin.
+    for (int j = 0; j < t; ++j)
+      Hl.bottomRightCorner(rest, rest).noalias() -= K.col(j) * Hl.row(j).tail(rest);
     gl.tail(rest).noalias() -= K * gl.head(t);
-    for (double* a : touched) {
-      const int la = local_offset[a], ga = offset[a], ta = tangentSizeOf(size_of[a]);
-      g.segment(ga, ta) += gl.segment(la, ta);
-      for (double* b : touched) {
-        const int lb = local_offset[b], tb = tangentSizeOf(size_of[b]);
-        H.block(ga, offset[b], ta, tb) += Hl.block(la, lb, ta, tb);
+    for (std::size_t a = 1; a < local.size(); ++a) {
+      const LocalBlock& la = local[a];
+      g.segment(la.offset, la.tangent_size) += gl.segment(la.local_offset, la.tangent_size);
+      for (std::size_t b = 1; b < local.size(); ++b) {
+        const LocalBlock& lb = local[b];
+        H.block(la.offset, lb.offset, la.tangent_size, lb.tangent_size) +=
+            Hl.block(la.local_offset, lb.local_offset, la.tangent_size, lb.tangent_size);
       }
     }
   }
