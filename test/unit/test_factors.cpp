@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <ceres/sized_cost_function.h>
+
 #include <Eigen/Eigenvalues>
 #include <random>
 
@@ -199,6 +201,72 @@ TEST(Marginalization, PriorIgnoresQuaternionSign) {
   prior.Evaluate(params, r2.data(), nullptr);
   EXPECT_LT((r1 - r2).norm(), 1e-12);
   EXPECT_LT(test::checkJacobians(prior, {pose1, pose2}).max_rel_error, 1e-6);
+}
+
+// r = A [x1; x2] + b over two Euclidean blocks of sizes 3 and 5.
+class LinearFactor : public ceres::SizedCostFunction<10, 3, 5> {
+ public:
+  LinearFactor(const Eigen::Matrix<double, 10, 8>& A, const Eigen::Matrix<double, 10, 1>& b)
+      : A_(A), b_(b) {}
+  bool Evaluate(double const* const* x, double* residuals, double** jacobians) const override {
+    Eigen::Matrix<double, 8, 1> xx;
+    xx << Eigen::Map<const Eigen::Vector3d>(x[0]),
+        Eigen::Map<const Eigen::Matrix<double, 5, 1>>(x[1]);
+    Eigen::Map<Eigen::Matrix<double, 10, 1>> r(residuals);
+    r = A_ * xx + b_;
+    if (jacobians && jacobians[0]) {
+      Eigen::Map<Eigen::Matrix<double, 10, 3, Eigen::RowMajor>> J1(jacobians[0]);
+      J1 = A_.leftCols<3>();
+    }
+    if (jacobians && jacobians[1]) {
+      Eigen::Map<Eigen::Matrix<double, 10, 5, Eigen::RowMajor>> J2(jacobians[1]);
+      J2 = A_.rightCols<5>();
+    }
+    return true;
+  }
+
+ private:
+  Eigen::Matrix<double, 10, 8> A_;
+  Eigen::Matrix<double, 10, 1> b_;
+};
+
+// A prior formed from one factor alone (the path of every frame that is not a keyframe: the
+// last prior, its second-newest pose dropped) equals the Schur complement of that factor's
+// information, also when the dropped block is not fully constrained.
+TEST(Marginalization, PriorOfOneFactorEqualsSchurComplement) {
+  std::mt19937 gen(3);
+  std::normal_distribution<double> normal;
+  for (bool deficient : {false, true}) {
+    Eigen::Matrix<double, 10, 8> A;
+    Eigen::Matrix<double, 10, 1> b;
+    for (int i = 0; i < A.size(); ++i) A.data()[i] = 100 * normal(gen);
+    for (int i = 0; i < b.size(); ++i) b[i] = normal(gen);
+    if (deficient) A.col(2) = A.col(0) - 0.5 * A.col(1);  // x1 only constrained in 2 directions
+    double x1[3] = {0.1, -0.2, 0.3}, x2[5] = {0.5, 0.4, -0.1, 0.2, 0.0};
+    auto info = std::make_shared<MarginalizationInfo>();
+    info->addResidualBlock(new LinearFactor(A, b), nullptr, {x1, x2}, {0});
+    ASSERT_TRUE(info->marginalize());
+    Eigen::Matrix<double, 8, 1> x;
+    x << Eigen::Map<Eigen::Vector3d>(x1), Eigen::Map<Eigen::Matrix<double, 5, 1>>(x2);
+    const Eigen::MatrixXd H = A.transpose() * A;
+    const Eigen::VectorXd g = A.transpose() * (A * x + b);
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(H.topLeftCorner(3, 3));
+    const Eigen::VectorXd inv = (es.eigenvalues().array() > 1e-9 * es.eigenvalues().maxCoeff())
+                                    .select(es.eigenvalues().array().inverse(), 0.0);
+    const Eigen::MatrixXd H11_inv =
+        es.eigenvectors() * inv.asDiagonal() * es.eigenvectors().transpose();
+    const Eigen::MatrixXd H22 =
+        H.bottomRightCorner(5, 5) - H.bottomLeftCorner(5, 3) * H11_inv * H.topRightCorner(3, 5);
+    const Eigen::VectorXd g2 = g.tail(5) - H.bottomLeftCorner(5, 3) * H11_inv * g.head(3);
+    const Eigen::MatrixXd& J = info->linearizedJacobian();
+    EXPECT_EQ(J.rows(), deficient ? 8 : 7) << "one row per direction x1 takes";
+    EXPECT_LT((J.transpose() * J - H22).norm() / H22.norm(), 1e-10) << deficient;
+    EXPECT_LT((J.transpose() * info->linearizedResidual() - g2).norm() / g2.norm(), 1e-10)
+        << deficient;
+    MarginalizationFactor prior(info);
+    EXPECT_EQ(prior.num_residuals(), J.rows());
+    EXPECT_LT(test::checkJacobians(prior, {x2}).max_rel_error, 1e-6);
+  }
 }
 
 // A rank-deficient information, at the scale of a window's prior, becomes as many non-zero

@@ -1,6 +1,7 @@
 #include "alvio/estimator/factors/marginalization.h"
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -82,15 +83,13 @@ Eigen::MatrixXd symmetricPseudoInverse(const Eigen::MatrixXd& A) {
   return es.eigenvectors() * inv.asDiagonal() * es.eigenvectors().transpose();
 }
 
-// Evaluates a factor at the current values and adds its J^T J and J^T r (tangent space,
-// robust loss applied) to a system, at the blocks' offsets there. The matrices keep their
-// storage from one factor to the next: most factors have the same shapes.
+// Linearises factors at the current values, in the tangent space.
 class FactorLinearizer {
  public:
-  template <typename OffsetOf>
-  void addTo(const ceres::CostFunction& cost, const ceres::LossFunction* loss,
-             const std::vector<double*>& blocks, OffsetOf offset_of, Eigen::MatrixXd* H,
-             Eigen::VectorXd* g) {
+  /// The factor's tangent-space Jacobian (all blocks side by side, columns()[k] onwards for
+  /// block k) and residual, robust loss applied.
+  void evaluate(const ceres::CostFunction& cost, const ceres::LossFunction* loss,
+                const std::vector<double*>& blocks) {
     const int num_residuals = cost.num_residuals();
     const auto& sizes = cost.parameter_block_sizes();
     r_.resize(num_residuals);
@@ -105,13 +104,25 @@ class FactorLinearizer {
     }
     if (!cost.Evaluate(blocks.data(), r_.data(), jac_ptrs_.data()))
       throw Error("marginalisation: a factor failed to evaluate");
-    // All blocks side by side: one product gives every block pair's J_a^T J_b (per pair,
-    // Eigen's matrix product set-up cost more than these few-column products).
     J_.resize(num_residuals, column_.back());
     for (std::size_t k = 0; k < blocks.size(); ++k)
       tangentJacobian(Ja_[k], blocks[k], sizes[k],
                       J_.middleCols(column_[k], column_[k + 1] - column_[k]));
     if (loss) applyLoss(*loss, &r_, &J_);
+  }
+  const Eigen::MatrixXd& jacobian() const { return J_; }
+  const Eigen::VectorXd& residual() const { return r_; }
+  const std::vector<int>& columns() const { return column_; }
+
+  /// Evaluates the factor and adds its J^T J and J^T r to a system, at the blocks' offsets
+  /// there.
+  template <typename OffsetOf>
+  void addTo(const ceres::CostFunction& cost, const ceres::LossFunction* loss,
+             const std::vector<double*>& blocks, OffsetOf offset_of, Eigen::MatrixXd* H,
+             Eigen::VectorXd* g) {
+    evaluate(cost, loss, blocks);
+    // One product gives every block pair's J_a^T J_b (per pair, Eigen's matrix product
+    // set-up cost more than these few-column products).
     JtJ_.noalias() = J_.transpose() * J_;
     Jtr_.noalias() = J_.transpose() * r_;
     for (std::size_t a = 0; a < blocks.size(); ++a) {
@@ -125,12 +136,36 @@ class FactorLinearizer {
   }
 
  private:
+  // The matrices keep their storage from one factor to the next: most have the same shapes.
   Eigen::VectorXd r_, Jtr_;
   std::vector<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> Ja_;
   std::vector<double*> jac_ptrs_;
   std::vector<int> column_;
   Eigen::MatrixXd J_, JtJ_;
 };
+
+// The prior that one factor, linearised in `f`, leaves on its kept columns: a QR
+// decomposition of [J_dropped | J_kept | r] (columns at `offset`: m dropped, then n kept)
+// eliminates the dropped states; the rows they cannot explain are the prior.
+void eliminateByQr(const FactorLinearizer& f, const std::vector<double*>& blocks,
+                   const std::unordered_map<double*, int>& offset, int m, int n, Eigen::MatrixXd* J,
+                   Eigen::VectorXd* r) {
+  const int rows = static_cast<int>(f.residual().size());
+  Eigen::MatrixXd A(rows, m + n + 1);
+  for (std::size_t k = 0; k < blocks.size(); ++k) {
+    const int c = f.columns()[k], t = f.columns()[k + 1] - c;
+    A.middleCols(offset.at(blocks[k]), t) = f.jacobian().middleCols(c, t);
+  }
+  A.col(m + n) = f.residual();
+  int used = 0;  // rows the dropped states take
+  if (m > 0) {
+    const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(A.leftCols(m));
+    used = static_cast<int>(qr.rank());
+    A.rightCols(n + 1).applyOnTheLeft(qr.householderQ().adjoint());
+  }
+  *J = A.bottomRows(rows - used).middleCols(m, n);
+  *r = A.bottomRows(rows - used).col(m + n);
+}
 
 // Pivots below this fraction of H's largest diagonal entry are rounding noise. In a window's
 // prior the kept pivots were at least 3e-9 of it, the others at most 6e-12 (median 1e-14 and
@@ -235,73 +270,81 @@ bool MarginalizationInfo::marginalize() {
   for (double* b : kept) offset[b] = m + n, n += tangentSizeOf(size_of[b]);
   if (n == 0) return false;
 
-  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(m + n, m + n);
-  Eigen::VectorXd g = Eigen::VectorXd::Zero(m + n);
   FactorLinearizer linearize;
-  for (std::size_t i : state_factors)
-    linearize.addTo(
-        *factors_[i].cost, factors_[i].loss.get(), factors_[i].blocks,
-        [&](double* b) { return offset[b]; }, &H, &g);
+  if (landmarks.empty() && state_factors.size() == 1) {
+    // The prior alone, when the second-newest frame leaves the window (every frame that is
+    // not a keyframe): no information matrix needed.
+    const Block& f = factors_[state_factors[0]];
+    linearize.evaluate(*f.cost, f.loss.get(), f.blocks);
+    eliminateByQr(linearize, f.blocks, offset, m, n, &linearized_jacobian_, &linearized_residual_);
+  } else {
+    Eigen::MatrixXd H = Eigen::MatrixXd::Zero(m + n, m + n);
+    Eigen::VectorXd g = Eigen::VectorXd::Zero(m + n);
+    for (std::size_t i : state_factors)
+      linearize.addTo(
+          *factors_[i].cost, factors_[i].loss.get(), factors_[i].blocks,
+          [&](double* b) { return offset[b]; }, &H, &g);
 
-  // Each landmark: [landmark, the states its factors touch], the landmark eliminated there.
-  // A landmark touches a dozen blocks at most: a list finds them faster than a hash map.
-  struct LocalBlock {
-    double* address;
-    int local_offset, offset, tangent_size;
-  };
-  std::vector<LocalBlock> local;
-  auto localOffset = [&](double* b) {
-    for (const LocalBlock& l : local)
-      if (l.address == b) return l.local_offset;
-    return -1;
-  };
-  Eigen::MatrixXd Hl, K;
-  Eigen::VectorXd gl;
-  for (double* landmark : landmarks) {
-    const int t = tangentSizeOf(size_of[landmark]);
-    local.assign(1, {landmark, 0, -1, t});
-    int size = t;
-    for (std::size_t i : factors_of[landmark])
-      for (double* b : factors_[i].blocks)
-        if (localOffset(b) < 0) {
-          const int tb = tangentSizeOf(size_of[b]);
-          local.push_back({b, size, offset[b], tb});
-          size += tb;
+    // Each landmark: [landmark, the states its factors touch], the landmark eliminated there.
+    // A landmark touches a dozen blocks at most: a list finds them faster than a hash map.
+    struct LocalBlock {
+      double* address;
+      int local_offset, offset, tangent_size;
+    };
+    std::vector<LocalBlock> local;
+    auto localOffset = [&](double* b) {
+      for (const LocalBlock& l : local)
+        if (l.address == b) return l.local_offset;
+      return -1;
+    };
+    Eigen::MatrixXd Hl, K;
+    Eigen::VectorXd gl;
+    for (double* landmark : landmarks) {
+      const int t = tangentSizeOf(size_of[landmark]);
+      local.assign(1, {landmark, 0, -1, t});
+      int size = t;
+      for (std::size_t i : factors_of[landmark])
+        for (double* b : factors_[i].blocks)
+          if (localOffset(b) < 0) {
+            const int tb = tangentSizeOf(size_of[b]);
+            local.push_back({b, size, offset[b], tb});
+            size += tb;
+          }
+      Hl.setZero(size, size);
+      gl.setZero(size);
+      for (std::size_t i : factors_of[landmark])
+        linearize.addTo(*factors_[i].cost, factors_[i].loss.get(), factors_[i].blocks, localOffset,
+                        &Hl, &gl);
+      // Pseudo-inverse: a landmark can be unconstrained in some direction.
+      const Eigen::MatrixXd inv = symmetricPseudoInverse(Hl.topLeftCorner(t, t));
+      const int rest = size - t;
+      K.noalias() = Hl.bottomLeftCorner(rest, t) * inv;
+      // Column by column: outer products of vectors, cheaper than a matrix product this thin.
+      for (int j = 0; j < t; ++j)
+        Hl.bottomRightCorner(rest, rest).noalias() -= K.col(j) * Hl.row(j).tail(rest);
+      gl.tail(rest).noalias() -= K * gl.head(t);
+      for (std::size_t a = 1; a < local.size(); ++a) {
+        const LocalBlock& la = local[a];
+        g.segment(la.offset, la.tangent_size) += gl.segment(la.local_offset, la.tangent_size);
+        for (std::size_t b = 1; b < local.size(); ++b) {
+          const LocalBlock& lb = local[b];
+          H.block(la.offset, lb.offset, la.tangent_size, lb.tangent_size) +=
+              Hl.block(la.local_offset, lb.local_offset, la.tangent_size, lb.tangent_size);
         }
-    Hl.setZero(size, size);
-    gl.setZero(size);
-    for (std::size_t i : factors_of[landmark])
-      linearize.addTo(*factors_[i].cost, factors_[i].loss.get(), factors_[i].blocks, localOffset,
-                      &Hl, &gl);
-    // Pseudo-inverse: a landmark can be unconstrained in some direction.
-    const Eigen::MatrixXd inv = symmetricPseudoInverse(Hl.topLeftCorner(t, t));
-    const int rest = size - t;
-    K.noalias() = Hl.bottomLeftCorner(rest, t) * inv;
-    // Column by column: outer products of vectors, cheaper than a matrix product this thin.
-    for (int j = 0; j < t; ++j)
-      Hl.bottomRightCorner(rest, rest).noalias() -= K.col(j) * Hl.row(j).tail(rest);
-    gl.tail(rest).noalias() -= K * gl.head(t);
-    for (std::size_t a = 1; a < local.size(); ++a) {
-      const LocalBlock& la = local[a];
-      g.segment(la.offset, la.tangent_size) += gl.segment(la.local_offset, la.tangent_size);
-      for (std::size_t b = 1; b < local.size(); ++b) {
-        const LocalBlock& lb = local[b];
-        H.block(la.offset, lb.offset, la.tangent_size, lb.tangent_size) +=
-            Hl.block(la.local_offset, lb.local_offset, la.tangent_size, lb.tangent_size);
       }
     }
-  }
 
-  // Schur complement onto the kept states.
-  Eigen::MatrixXd Hrr = H.bottomRightCorner(n, n);
-  Eigen::VectorXd gr = g.tail(n);
-  if (m > 0) {
-    const Eigen::MatrixXd Hmm_inv = symmetricPseudoInverse(H.topLeftCorner(m, m));
-    const Eigen::MatrixXd Hrm = H.bottomLeftCorner(n, m);
-    Hrr -= Hrm * Hmm_inv * Hrm.transpose();
-    gr -= Hrm * Hmm_inv * g.head(m);
+    // Schur complement onto the kept states.
+    Eigen::MatrixXd Hrr = H.bottomRightCorner(n, n);
+    Eigen::VectorXd gr = g.tail(n);
+    if (m > 0) {
+      const Eigen::MatrixXd Hmm_inv = symmetricPseudoInverse(H.topLeftCorner(m, m));
+      const Eigen::MatrixXd Hrm = H.bottomLeftCorner(n, m);
+      Hrr -= Hrm * Hmm_inv * Hrm.transpose();
+      gr -= Hrm * Hmm_inv * g.head(m);
+    }
+    factorPrior(0.5 * (Hrr + Hrr.transpose()), gr, &linearized_jacobian_, &linearized_residual_);
   }
-  factorPrior(0.5 * (Hrr + Hrr.transpose()), gr, &linearized_jacobian_, &linearized_residual_);
 
   kept_addresses_ = kept;
   kept_sizes_.clear();
@@ -332,7 +375,7 @@ std::vector<double*> MarginalizationInfo::keptBlocks(
 MarginalizationFactor::MarginalizationFactor(std::shared_ptr<const MarginalizationInfo> info)
     : info_(std::move(info)) {
   for (int size : info_->keptSizes()) mutable_parameter_block_sizes()->push_back(size);
-  set_num_residuals(info_->keptTangentSize());
+  set_num_residuals(static_cast<int>(info_->linearizedJacobian().rows()));
 }
 
 bool MarginalizationFactor::Evaluate(double const* const* parameters, double* residuals,
@@ -347,7 +390,8 @@ bool MarginalizationFactor::Evaluate(double const* const* parameters, double* re
         tangentDifference(parameters[k], info_->keptLinearizationPoints()[k].data(), sizes[k]);
     offset += t;
   }
-  Eigen::Map<Eigen::VectorXd> r(residuals, n);
+  const int rows = static_cast<int>(info_->linearizedJacobian().rows());
+  Eigen::Map<Eigen::VectorXd> r(residuals, rows);
   r = info_->linearizedResidual() + info_->linearizedJacobian() * dx;
   if (!jacobians) return true;
   offset = 0;
@@ -355,7 +399,7 @@ bool MarginalizationFactor::Evaluate(double const* const* parameters, double* re
     const int t = tangentSizeOf(sizes[k]);
     if (jacobians[k]) {
       Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> J(
-          jacobians[k], n, sizes[k]);
+          jacobians[k], rows, sizes[k]);
       const Eigen::MatrixXd Jt = info_->linearizedJacobian().middleCols(offset, t);
       if (sizes[k] != 7) {
         J = Jt;
