@@ -226,8 +226,9 @@ void MarginalizationInfo::addResidualBlock(ceres::CostFunction* cost, ceres::Los
   factors_.push_back(std::move(b));
 }
 
-bool MarginalizationInfo::marginalize() {
-  std::unordered_map<double*, int> size_of;
+MarginalizationInfo::Layout MarginalizationInfo::planLayout() const {
+  Layout layout;
+  std::unordered_map<double*, int>& size_of = layout.size_of;
   std::unordered_map<double*, bool> is_dropped;
   for (const auto& f : factors_) {
     const auto& sizes = f.cost->parameter_block_sizes();
@@ -240,9 +241,6 @@ bool MarginalizationInfo::marginalize() {
   auto isLandmark = [&](double* b) {
     return is_dropped.count(b) && (size_of[b] == 1 || size_of[b] == 4);
   };
-  std::vector<double*> dropped, kept, landmarks;
-  std::unordered_map<double*, std::vector<std::size_t>> factors_of;
-  std::vector<std::size_t> state_factors;
   for (std::size_t i = 0; i < factors_.size(); ++i) {
     double* landmark = nullptr;
     for (double* b : factors_[i].blocks) {
@@ -252,111 +250,123 @@ bool MarginalizationInfo::marginalize() {
         landmark = b;
         continue;
       }
-      auto& list = is_dropped.count(b) ? dropped : kept;
+      auto& list = is_dropped.count(b) ? layout.dropped : layout.kept;
       if (std::find(list.begin(), list.end(), b) == list.end()) list.push_back(b);
     }
     if (!landmark) {
-      state_factors.push_back(i);
+      layout.state_factors.push_back(i);
       continue;
     }
-    auto& of = factors_of[landmark];
-    if (of.empty()) landmarks.push_back(landmark);
+    auto& of = layout.factors_of[landmark];
+    if (of.empty()) layout.landmarks.push_back(landmark);
     of.push_back(i);
   }
-  std::unordered_map<double*, int> offset;
-  int m = 0, n = 0;
-  for (double* b : dropped) offset[b] = m, m += tangentSizeOf(size_of[b]);
-  for (double* b : kept) offset[b] = m + n, n += tangentSizeOf(size_of[b]);
-  if (n == 0) return false;
+  int& m = layout.m;
+  int& n = layout.n;
+  for (double* b : layout.dropped) layout.offset[b] = m, m += tangentSizeOf(size_of[b]);
+  for (double* b : layout.kept) layout.offset[b] = m + n, n += tangentSizeOf(size_of[b]);
+  return layout;
+}
 
-  FactorLinearizer linearize;
-  if (landmarks.empty() && state_factors.size() == 1) {
+bool MarginalizationInfo::marginalize() {
+  const Layout layout = planLayout();
+  if (layout.n == 0) return false;
+  if (layout.landmarks.empty() && layout.state_factors.size() == 1) {
     // The prior alone, when the second-newest frame leaves the window (every frame that is
     // not a keyframe): no information matrix needed.
-    const Block& f = factors_[state_factors[0]];
+    const Block& f = factors_[layout.state_factors[0]];
+    FactorLinearizer linearize;
     linearize.evaluate(*f.cost, f.loss.get(), f.blocks);
-    eliminateByQr(linearize, f.blocks, offset, m, n, &linearized_jacobian_, &linearized_residual_);
+    eliminateByQr(linearize, f.blocks, layout.offset, layout.m, layout.n, &linearized_jacobian_,
+                  &linearized_residual_);
   } else {
-    Eigen::MatrixXd H = Eigen::MatrixXd::Zero(m + n, m + n);
-    Eigen::VectorXd g = Eigen::VectorXd::Zero(m + n);
-    for (std::size_t i : state_factors)
-      linearize.addTo(
-          *factors_[i].cost, factors_[i].loss.get(), factors_[i].blocks,
-          [&](double* b) { return offset[b]; }, &H, &g);
-
-    // Each landmark: [landmark, the states its factors touch], the landmark eliminated there.
-    // A landmark touches a dozen blocks at most: a list finds them faster than a hash map.
-    struct LocalBlock {
-      double* address;
-      int local_offset, offset, tangent_size;
-    };
-    std::vector<LocalBlock> local;
-    auto localOffset = [&](double* b) {
-      for (const LocalBlock& l : local)
-        if (l.address == b) return l.local_offset;
-      return -1;
-    };
-    Eigen::MatrixXd Hl, K;
-    Eigen::VectorXd gl;
-    for (double* landmark : landmarks) {
-      const int t = tangentSizeOf(size_of[landmark]);
-      local.assign(1, {landmark, 0, -1, t});
-      int size = t;
-      for (std::size_t i : factors_of[landmark])
-        for (double* b : factors_[i].blocks)
-          if (localOffset(b) < 0) {
-            const int tb = tangentSizeOf(size_of[b]);
-            local.push_back({b, size, offset[b], tb});
-            size += tb;
-          }
-      Hl.setZero(size, size);
-      gl.setZero(size);
-      for (std::size_t i : factors_of[landmark])
-        linearize.addTo(*factors_[i].cost, factors_[i].loss.get(), factors_[i].blocks, localOffset,
-                        &Hl, &gl);
-      // Pseudo-inverse: a landmark can be unconstrained in some direction.
-      const Eigen::MatrixXd inv = symmetricPseudoInverse(Hl.topLeftCorner(t, t));
-      const int rest = size - t;
-      K.noalias() = Hl.bottomLeftCorner(rest, t) * inv;
-      // Column by column: outer products of vectors, cheaper than a matrix product this thin.
-      for (int j = 0; j < t; ++j)
-        Hl.bottomRightCorner(rest, rest).noalias() -= K.col(j) * Hl.row(j).tail(rest);
-      gl.tail(rest).noalias() -= K * gl.head(t);
-      for (std::size_t a = 1; a < local.size(); ++a) {
-        const LocalBlock& la = local[a];
-        g.segment(la.offset, la.tangent_size) += gl.segment(la.local_offset, la.tangent_size);
-        for (std::size_t b = 1; b < local.size(); ++b) {
-          const LocalBlock& lb = local[b];
-          H.block(la.offset, lb.offset, la.tangent_size, lb.tangent_size) +=
-              Hl.block(la.local_offset, lb.local_offset, la.tangent_size, lb.tangent_size);
-        }
-      }
-    }
-
-    // Schur complement onto the kept states.
-    Eigen::MatrixXd Hrr = H.bottomRightCorner(n, n);
-    Eigen::VectorXd gr = g.tail(n);
-    if (m > 0) {
-      const Eigen::MatrixXd Hmm_inv = symmetricPseudoInverse(H.topLeftCorner(m, m));
-      const Eigen::MatrixXd Hrm = H.bottomLeftCorner(n, m);
-      Hrr -= Hrm * Hmm_inv * Hrm.transpose();
-      gr -= Hrm * Hmm_inv * g.head(m);
-    }
-    factorPrior(0.5 * (Hrr + Hrr.transpose()), gr, &linearized_jacobian_, &linearized_residual_);
+    formPriorFromInformation(layout);
   }
 
-  kept_addresses_ = kept;
+  kept_addresses_ = layout.kept;
   kept_sizes_.clear();
   kept_tangent_sizes_.clear();
   kept_values_.clear();
-  for (double* b : kept) {
-    kept_sizes_.push_back(size_of[b]);
-    kept_tangent_sizes_.push_back(tangentSizeOf(size_of[b]));
-    kept_values_.emplace_back(b, b + size_of[b]);
+  for (double* b : layout.kept) {
+    const int size = layout.size_of.at(b);
+    kept_sizes_.push_back(size);
+    kept_tangent_sizes_.push_back(tangentSizeOf(size));
+    kept_values_.emplace_back(b, b + size);
   }
-  kept_tangent_size_ = n;
+  kept_tangent_size_ = layout.n;
   factors_.clear();  // the evaluated factors are no longer needed
   return true;
+}
+
+void MarginalizationInfo::formPriorFromInformation(const Layout& layout) {
+  const int m = layout.m, n = layout.n;
+  FactorLinearizer linearize;
+  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(m + n, m + n);
+  Eigen::VectorXd g = Eigen::VectorXd::Zero(m + n);
+  for (std::size_t i : layout.state_factors)
+    linearize.addTo(
+        *factors_[i].cost, factors_[i].loss.get(), factors_[i].blocks,
+        [&](double* b) { return layout.offset.at(b); }, &H, &g);
+
+  // Each landmark: [landmark, the states its factors touch], the landmark eliminated there.
+  // A landmark touches a dozen blocks at most: a list finds them faster than a hash map.
+  struct LocalBlock {
+    double* address;
+    int local_offset, offset, tangent_size;
+  };
+  std::vector<LocalBlock> local;
+  auto localOffset = [&](double* b) {
+    for (const LocalBlock& l : local)
+      if (l.address == b) return l.local_offset;
+    return -1;
+  };
+  Eigen::MatrixXd Hl, K;
+  Eigen::VectorXd gl;
+  for (double* landmark : layout.landmarks) {
+    const int t = tangentSizeOf(layout.size_of.at(landmark));
+    local.assign(1, {landmark, 0, -1, t});
+    int size = t;
+    for (std::size_t i : layout.factors_of.at(landmark))
+      for (double* b : factors_[i].blocks)
+        if (localOffset(b) < 0) {
+          const int tb = tangentSizeOf(layout.size_of.at(b));
+          local.push_back({b, size, layout.offset.at(b), tb});
+          size += tb;
+        }
+    Hl.setZero(size, size);
+    gl.setZero(size);
+    for (std::size_t i : layout.factors_of.at(landmark))
+      linearize.addTo(*factors_[i].cost, factors_[i].loss.get(), factors_[i].blocks, localOffset,
+                      &Hl, &gl);
+    // Pseudo-inverse: a landmark can be unconstrained in some direction.
+    const Eigen::MatrixXd inv = symmetricPseudoInverse(Hl.topLeftCorner(t, t));
+    const int rest = size - t;
+    K.noalias() = Hl.bottomLeftCorner(rest, t) * inv;
+    // Column by column: outer products of vectors, cheaper than a matrix product this thin.
+    for (int j = 0; j < t; ++j)
+      Hl.bottomRightCorner(rest, rest).noalias() -= K.col(j) * Hl.row(j).tail(rest);
+    gl.tail(rest).noalias() -= K * gl.head(t);
+    for (std::size_t a = 1; a < local.size(); ++a) {
+      const LocalBlock& la = local[a];
+      g.segment(la.offset, la.tangent_size) += gl.segment(la.local_offset, la.tangent_size);
+      for (std::size_t b = 1; b < local.size(); ++b) {
+        const LocalBlock& lb = local[b];
+        H.block(la.offset, lb.offset, la.tangent_size, lb.tangent_size) +=
+            Hl.block(la.local_offset, lb.local_offset, la.tangent_size, lb.tangent_size);
+      }
+    }
+  }
+
+  // Schur complement onto the kept states.
+  Eigen::MatrixXd Hrr = H.bottomRightCorner(n, n);
+  Eigen::VectorXd gr = g.tail(n);
+  if (m > 0) {
+    const Eigen::MatrixXd Hmm_inv = symmetricPseudoInverse(H.topLeftCorner(m, m));
+    const Eigen::MatrixXd Hrm = H.bottomLeftCorner(n, m);
+    Hrr -= Hrm * Hmm_inv * Hrm.transpose();
+    gr -= Hrm * Hmm_inv * g.head(m);
+  }
+  factorPrior(0.5 * (Hrr + Hrr.transpose()), gr, &linearized_jacobian_, &linearized_residual_);
 }
 
 std::vector<double*> MarginalizationInfo::keptBlocks(

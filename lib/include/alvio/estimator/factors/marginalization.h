@@ -11,6 +11,7 @@
 #include <Eigen/Core>
 #include <map>
 #include <memory>
+#include <unordered_map>
 #include <vector>
 
 namespace alvio {
@@ -47,6 +48,19 @@ class MarginalizationInfo {
     std::vector<double*> blocks;
     std::vector<int> drop;
   };
+  /// Where the blocks go: the states (dropped first, then kept) at tangent offsets in one
+  /// dense system; each dropped landmark (inverse depth, line) with the factors that see it.
+  struct Layout {
+    std::unordered_map<double*, int> size_of, offset;
+    std::vector<double*> dropped, kept, landmarks;
+    std::unordered_map<double*, std::vector<std::size_t>> factors_of;
+    std::vector<std::size_t> state_factors;  ///< factors without a landmark
+    int m = 0, n = 0;                        ///< tangent sizes of the dropped and kept states
+  };
+  Layout planLayout() const;
+  /// The prior from the factors' information, landmarks eliminated one by one.
+  void formPriorFromInformation(const Layout& layout);
+
   std::vector<Block> factors_;
   std::vector<double*> kept_addresses_;
   std::vector<int> kept_sizes_, kept_tangent_sizes_;
