@@ -285,12 +285,10 @@ bool MarginalizationInfo::marginalize() {
 
   kept_addresses_ = layout.kept;
   kept_sizes_.clear();
-  kept_tangent_sizes_.clear();
   kept_values_.clear();
   for (double* b : layout.kept) {
     const int size = layout.size_of.at(b);
     kept_sizes_.push_back(size);
-    kept_tangent_sizes_.push_back(tangentSizeOf(size));
     kept_values_.emplace_back(b, b + size);
   }
   kept_tangent_size_ = layout.n;

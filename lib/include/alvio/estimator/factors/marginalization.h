@@ -34,7 +34,6 @@ class MarginalizationInfo {
   // The prior, for MarginalizationFactor.
   int keptTangentSize() const { return kept_tangent_size_; }
   const std::vector<int>& keptSizes() const { return kept_sizes_; }
-  const std::vector<int>& keptTangentSizes() const { return kept_tangent_sizes_; }
   const std::vector<std::vector<double>>& keptLinearizationPoints() const { return kept_values_; }
   const Eigen::MatrixXd& linearizedJacobian() const { return linearized_jacobian_; }
   const Eigen::VectorXd& linearizedResidual() const { return linearized_residual_; }
@@ -63,7 +62,7 @@ class MarginalizationInfo {
 
   std::vector<Block> factors_;
   std::vector<double*> kept_addresses_;
-  std::vector<int> kept_sizes_, kept_tangent_sizes_;
+  std::vector<int> kept_sizes_;
   std::vector<std::vector<double>> kept_values_;
   int kept_tangent_size_ = 0;
   Eigen::MatrixXd linearized_jacobian_;
