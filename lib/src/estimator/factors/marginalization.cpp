@@ -201,19 +201,18 @@ void factorPrior(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, Eigen::Matr
   }
   // H = P^T L D L^T P with L (n x rank) unit lower triangular: J = D^1/2 L^T P.
   const Eigen::VectorXd sqrt_d = A.diagonal().head(rank).cwiseSqrt();
-  J->setZero(n, n);
+  J->setZero(rank, n);
   Eigen::VectorXd pg(n);
   for (int i = 0; i < n; ++i) {
     pg[i] = g[perm[i]];
     for (int k = 0; k < std::min(i, rank); ++k) (*J)(k, perm[i]) = A(i, k) * sqrt_d[k];
     if (i < rank) (*J)(i, perm[i]) = sqrt_d[i];
   }
-  // r = D^-1/2 L^-1 P g over the first `rank` rows (g lies in H's range).
-  r->setZero(n);
-  r->head(rank) = A.topLeftCorner(rank, rank)
-                      .triangularView<Eigen::UnitLower>()
-                      .solve(pg.head(rank))
-                      .cwiseQuotient(sqrt_d);
+  // r = D^-1/2 L^-1 P g (g lies in H's range).
+  *r = A.topLeftCorner(rank, rank)
+           .triangularView<Eigen::UnitLower>()
+           .solve(pg.head(rank))
+           .cwiseQuotient(sqrt_d);
 }
 
 void MarginalizationInfo::addResidualBlock(ceres::CostFunction* cost, ceres::LossFunction* loss,
@@ -282,6 +281,7 @@ bool MarginalizationInfo::marginalize() {
   } else {
     formPriorFromInformation(layout);
   }
+  if (linearized_jacobian_.rows() == 0) return false;  // Ceres needs a residual
 
   kept_addresses_ = layout.kept;
   kept_sizes_.clear();
@@ -407,7 +407,7 @@ bool MarginalizationFactor::Evaluate(double const* const* parameters, double* re
     if (jacobians[k]) {
       Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> J(
           jacobians[k], rows, sizes[k]);
-      const Eigen::MatrixXd Jt = info_->linearizedJacobian().middleCols(offset, t);
+      const auto Jt = info_->linearizedJacobian().middleCols(offset, t);
       if (sizes[k] != 7) {
         J = Jt;
       } else {
@@ -417,7 +417,9 @@ bool MarginalizationFactor::Evaluate(double const* const* parameters, double* re
         const Eigen::Vector3d half_angle = dx.segment<3>(offset + 3);
         Eigen::Matrix<double, 6, 6> D = Eigen::Matrix<double, 6, 6>::Identity();
         D.bottomRightCorner<3, 3>() = inverseLeftJacobian(2.0 * half_angle);
-        J = Jt * D * posePlusJacobian(parameters[k]).transpose();
+        const Eigen::Matrix<double, 6, 7> to_ambient =
+            D * posePlusJacobian(parameters[k]).transpose();
+        J.noalias() = Jt * to_ambient;
       }
     }
     offset += t;

@@ -24,7 +24,7 @@ class MarginalizationInfo {
                         std::vector<double*> blocks, std::vector<int> drop);
 
   /// Evaluate all factors at the current parameter values and form the prior.
-  /// Returns false when nothing is kept (no prior).
+  /// Returns false when nothing is kept or the kept states learn nothing (no prior).
   bool marginalize();
 
   /// After the window shifted: the kept blocks' new addresses (old address -> new).
@@ -85,7 +85,7 @@ class MarginalizationFactor : public ceres::CostFunction {
 /// diagonal pivoting, H = P^T L D L^T P: J = D^1/2 L^T P, r = D^-1/2 L^-1 P g (n^3 / 3
 /// multiplications, where an eigendecomposition with its vectors takes about 9 n^3). The pivoting
 /// leaves the directions H does not constrain (the window's position and yaw) last, where D is
-/// rounding noise: they become zero rows.
+/// rounding noise: J has one row per direction H constrains (rank x n), none for the others.
 void factorPrior(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, Eigen::MatrixXd* J,
                  Eigen::VectorXd* r);
 
