@@ -121,8 +121,15 @@ class FactorLinearizer {
              Eigen::VectorXd* g) {
     evaluate(cost, loss, blocks);
     // One product gives every block pair's J_a^T J_b (per pair, Eigen's matrix product
-    // set-up cost more than these few-column products).
-    JtJ_.noalias() = J_.transpose() * J_;
+    // set-up cost more than these few-column products). Two-row factors (points, lines) with
+    // the depth fixed at compile time: a blocked product's set-up would cost more than the
+    // product itself (and a lazy product of dynamic depth, more again).
+    if (J_.rows() == 2) {
+      const Eigen::Map<const Eigen::Matrix<double, 2, Eigen::Dynamic>> J2(J_.data(), 2, J_.cols());
+      JtJ_.noalias() = J2.transpose() * J2;
+    } else {
+      JtJ_.noalias() = J_.transpose() * J_;
+    }
     Jtr_.noalias() = J_.transpose() * r_;
     for (std::size_t a = 0; a < blocks.size(); ++a) {
       const int ia = offset_of(blocks[a]), ta = column_[a + 1] - column_[a];
@@ -312,7 +319,7 @@ void MarginalizationInfo::formPriorFromInformation(const Layout& layout) {
     double* address;
     int local_offset, offset, tangent_size;
   };
-  std::vector<LocalBlock> local;
+  std::vector<LocalBlock> local, runs;
   auto localOffset = [&](double* b) {
     for (const LocalBlock& l : local)
       if (l.address == b) return l.local_offset;
@@ -344,14 +351,22 @@ void MarginalizationInfo::formPriorFromInformation(const Layout& layout) {
     for (int j = 0; j < t; ++j)
       Hl.bottomRightCorner(rest, rest).noalias() -= K.col(j) * Hl.row(j).tail(rest);
     gl.tail(rest).noalias() -= K * gl.head(t);
+    // Scatter into the states' system by runs of blocks that are neighbours both here and
+    // there (a landmark's poses mostly are): a few block sums instead of one per block pair,
+    // each entry added once as before.
+    runs.clear();
     for (std::size_t a = 1; a < local.size(); ++a) {
       const LocalBlock& la = local[a];
-      g.segment(la.offset, la.tangent_size) += gl.segment(la.local_offset, la.tangent_size);
-      for (std::size_t b = 1; b < local.size(); ++b) {
-        const LocalBlock& lb = local[b];
-        H.block(la.offset, lb.offset, la.tangent_size, lb.tangent_size) +=
-            Hl.block(la.local_offset, lb.local_offset, la.tangent_size, lb.tangent_size);
-      }
+      if (!runs.empty() && runs.back().offset + runs.back().tangent_size == la.offset)
+        runs.back().tangent_size += la.tangent_size;  // local offsets are consecutive already
+      else
+        runs.push_back(la);
+    }
+    for (const LocalBlock& ra : runs) {
+      g.segment(ra.offset, ra.tangent_size) += gl.segment(ra.local_offset, ra.tangent_size);
+      for (const LocalBlock& rb : runs)
+        H.block(ra.offset, rb.offset, ra.tangent_size, rb.tangent_size) +=
+            Hl.block(ra.local_offset, rb.local_offset, ra.tangent_size, rb.tangent_size);
     }
   }
 
