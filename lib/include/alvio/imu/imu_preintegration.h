@@ -56,9 +56,8 @@ class ImuPreintegration {
   const Eigen::Vector3d& linearizedBg() const { return linearized_bg_; }
   const Matrix15& jacobian() const { return jacobian_; }
   const Matrix15& covariance() const { return covariance_; }
-  /// L^T of the covariance's inverse (r^T Info r = |L^T r|^2; upper triangular), as the IMU
-  /// factor weighs its residual; worked out once per covariance, not once per factor built on each
-  /// solve.
+  /// L^T of the covariance's inverse (r^T Info r = |L^T r|^2), upper triangular: what the IMU
+  /// factor weighs its residual by. Worked out once per covariance, not per factor and solve.
   const Matrix15& sqrtInformation() const;
   std::size_t sampleCount() const { return dts_.size(); }
   const std::vector<double>& dts() const { return dts_; }
