@@ -313,7 +313,12 @@ void MarginalizationInfo::formPriorFromInformation(const Layout& layout) {
     double* address;
     int local_offset, offset, tangent_size;
   };
-  std::vector<LocalBlock> local, runs;
+  // A stretch of blocks that are neighbours both in the landmark's system and in the states'.
+  struct Run {
+    int local_offset, offset, size;
+  };
+  std::vector<LocalBlock> local;
+  std::vector<Run> runs;
   auto localOffset = [&](double* b) {
     for (const LocalBlock& l : local)
       if (l.address == b) return l.local_offset;
@@ -351,16 +356,16 @@ void MarginalizationInfo::formPriorFromInformation(const Layout& layout) {
     runs.clear();
     for (std::size_t a = 1; a < local.size(); ++a) {
       const LocalBlock& la = local[a];
-      if (!runs.empty() && runs.back().offset + runs.back().tangent_size == la.offset)
-        runs.back().tangent_size += la.tangent_size;  // local offsets are consecutive already
+      if (!runs.empty() && runs.back().offset + runs.back().size == la.offset)
+        runs.back().size += la.tangent_size;  // local offsets are consecutive already
       else
-        runs.push_back(la);
+        runs.push_back({la.local_offset, la.offset, la.tangent_size});
     }
-    for (const LocalBlock& ra : runs) {
-      g.segment(ra.offset, ra.tangent_size) += gl.segment(ra.local_offset, ra.tangent_size);
-      for (const LocalBlock& rb : runs)
-        H.block(ra.offset, rb.offset, ra.tangent_size, rb.tangent_size) +=
-            Hl.block(ra.local_offset, rb.local_offset, ra.tangent_size, rb.tangent_size);
+    for (const Run& ra : runs) {
+      g.segment(ra.offset, ra.size) += gl.segment(ra.local_offset, ra.size);
+      for (const Run& rb : runs)
+        H.block(ra.offset, rb.offset, ra.size, rb.size) +=
+            Hl.block(ra.local_offset, rb.local_offset, ra.size, rb.size);
     }
   }
 
