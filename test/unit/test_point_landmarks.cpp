@@ -96,3 +96,54 @@ TEST(PointLandmarks, RetriangulateKeepsTheDepthWhenTheSightingsDoNotPlaceThePoin
                           [](const PointLandmark&) { return true; });
   EXPECT_DOUBLE_EQ(landmarks.landmarks().at(1).depth, 3.0);
 }
+
+// Landmarks first seen in different frames share the window's poses: each is placed from its
+// own first camera, whatever the others' (rotating body, camera offset from the body).
+TEST(PointLandmarks, EveryLandmarkIsTriangulatedFromItsOwnFirstCamera) {
+  Eigen::Isometry3d T_b_c = Eigen::Isometry3d::Identity();
+  T_b_c.linear() = Eigen::AngleAxisd(0.2, Eigen::Vector3d(0.3, 1, 0).normalized()).matrix();
+  T_b_c.translation() = Eigen::Vector3d(0.05, -0.02, 0.01);
+  std::vector<Eigen::Vector3d> P;
+  std::vector<Eigen::Matrix3d> R;
+  for (int i = 0; i < 6; ++i) {
+    P.emplace_back(0.12 * i, 0.03 * i * i, -0.02 * i);
+    R.push_back(Eigen::AngleAxisd(0.05 * i, Eigen::Vector3d::UnitZ()).matrix() *
+                Eigen::AngleAxisd(-0.03 * i, Eigen::Vector3d::UnitX()).matrix());
+  }
+  auto inCamera = [&](int i, const Eigen::Vector3d& p_w) -> Eigen::Vector3d {
+    const Eigen::Matrix3d R_w_c = R[i] * T_b_c.linear();
+    return R_w_c.transpose() * (p_w - (P[i] + R[i] * T_b_c.translation()));
+  };
+  struct Truth {
+    int start, end;
+    Eigen::Vector3d p_w;
+  };
+  const std::vector<Truth> truths = {{0, 5, {0.4, 0.3, 5.0}},
+                                     {1, 4, {-0.6, 0.1, 3.5}},
+                                     {2, 5, {0.2, -0.5, 6.0}},
+                                     {3, 5, {1.0, 0.4, 4.2}}};
+  PointLandmarks landmarks(10, kMinParallax);
+  for (std::size_t id = 0; id < truths.size(); ++id) {
+    PointLandmark l;
+    l.id = static_cast<int>(id);
+    l.start_frame = truths[id].start;
+    for (int i = truths[id].start; i <= truths[id].end; ++i) {
+      const Eigen::Vector3d c = inCamera(i, truths[id].p_w);
+      PointSighting s;
+      s.xy1 = c / c.z();
+      l.sightings.push_back(s);
+    }
+    landmarks.landmarks().emplace(l.id, l);
+  }
+  auto expectTrueDepths = [&](const char* after) {
+    for (std::size_t id = 0; id < truths.size(); ++id)
+      EXPECT_NEAR(landmarks.landmarks().at(static_cast<int>(id)).depth,
+                  inCamera(truths[id].start, truths[id].p_w).z(), 1e-9)
+          << "landmark " << id << " after " << after;
+  };
+  landmarks.triangulate(P, R, T_b_c);
+  expectTrueDepths("triangulate");
+  for (auto& [id, l] : landmarks.landmarks()) l.depth = 9.0;  // stale
+  landmarks.retriangulate(P, R, T_b_c, [](const PointLandmark&) { return true; });
+  expectTrueDepths("retriangulate");
+}

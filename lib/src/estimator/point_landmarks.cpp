@@ -61,28 +61,55 @@ std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> PointLandmarks::corresp
 
 namespace {
 
+// Projection matrices [R^T | -R^T t] of camera i relative to an anchor camera i0, for every
+// pair of window frames a landmark needs: many landmarks share an anchor, so each pair is
+// computed once per triangulation pass instead of once per sighting.
+class RelativeProjections {
+ public:
+  RelativeProjections(const std::vector<Eigen::Vector3d>& P, const std::vector<Eigen::Matrix3d>& R,
+                      const Eigen::Isometry3d& T_b_c)
+      : P_(P),
+        R_(R),
+        R_b_c_(T_b_c.linear()),
+        t_b_c_(T_b_c.translation()),
+        n_(P.size()),
+        projection_(n_ * n_),
+        known_(n_ * n_, false) {}
+
+  const Eigen::Matrix<double, 3, 4>& operator()(int i0, int i) {
+    const std::size_t k = static_cast<std::size_t>(i0) * n_ + static_cast<std::size_t>(i);
+    if (!known_[k]) {
+      const Eigen::Vector3d t0 = P_[i0] + R_[i0] * t_b_c_;
+      const Eigen::Matrix3d R0 = R_[i0] * R_b_c_;
+      const Eigen::Vector3d t1 = P_[i] + R_[i] * t_b_c_;
+      const Eigen::Matrix3d R1 = R_[i] * R_b_c_;
+      // Pose of anchor-frame points in camera i: x_i = R^T (x_0 - t).
+      const Eigen::Vector3d t = R0.transpose() * (t1 - t0);
+      const Eigen::Matrix3d Rr = R0.transpose() * R1;
+      projection_[k].leftCols<3>() = Rr.transpose();
+      projection_[k].rightCols<1>() = -Rr.transpose() * t;
+      known_[k] = true;
+    }
+    return projection_[k];
+  }
+
+ private:
+  const std::vector<Eigen::Vector3d>& P_;
+  const std::vector<Eigen::Matrix3d>& R_;
+  const Eigen::Matrix3d R_b_c_;
+  const Eigen::Vector3d t_b_c_;
+  const std::size_t n_;
+  std::vector<Eigen::Matrix<double, 3, 4>> projection_;
+  std::vector<bool> known_;
+};
+
 // The two DLT rows of each sighting (a_k^T X = 0 for the point X in the anchor camera):
 // row(k, r0, r1) for k over the sightings.
 template <class RowPair>
-void forEachDltRowPair(const PointLandmark& l, const std::vector<Eigen::Vector3d>& P,
-                       const std::vector<Eigen::Matrix3d>& R, const Eigen::Isometry3d& T_b_c,
-                       RowPair&& row) {
-  const Eigen::Matrix3d R_b_c = T_b_c.linear();
-  const Eigen::Vector3d t_b_c = T_b_c.translation();
-  // Camera poses relative to the anchor camera.
+void forEachDltRowPair(const PointLandmark& l, RelativeProjections& projection, RowPair&& row) {
   const int i0 = l.start_frame;
-  const Eigen::Vector3d t0 = P[i0] + R[i0] * t_b_c;
-  const Eigen::Matrix3d R0 = R[i0] * R_b_c;
   for (std::size_t k = 0; k < l.sightings.size(); ++k) {
-    const int i = i0 + static_cast<int>(k);
-    const Eigen::Vector3d t1 = P[i] + R[i] * t_b_c;
-    const Eigen::Matrix3d R1 = R[i] * R_b_c;
-    // Pose of anchor-frame points in camera i: x_i = R^T (x_0 - t).
-    const Eigen::Vector3d t = R0.transpose() * (t1 - t0);
-    const Eigen::Matrix3d Rr = R0.transpose() * R1;
-    Eigen::Matrix<double, 3, 4> Pm;
-    Pm.leftCols<3>() = Rr.transpose();
-    Pm.rightCols<1>() = -Rr.transpose() * t;
+    const Eigen::Matrix<double, 3, 4>& Pm = projection(i0, i0 + static_cast<int>(k));
     const Eigen::Vector3d f = l.sightings[k].xy1.normalized();
     row(k, Eigen::RowVector4d(f[0] * Pm.row(2) - f[2] * Pm.row(0)),
         Eigen::RowVector4d(f[1] * Pm.row(2) - f[2] * Pm.row(1)));
@@ -90,10 +117,9 @@ void forEachDltRowPair(const PointLandmark& l, const std::vector<Eigen::Vector3d
 }
 
 // Depth in the anchor camera by linear triangulation (DLT) over all sightings.
-double dltDepth(const PointLandmark& l, const std::vector<Eigen::Vector3d>& P,
-                const std::vector<Eigen::Matrix3d>& R, const Eigen::Isometry3d& T_b_c) {
+double dltDepth(const PointLandmark& l, RelativeProjections& projection) {
   Eigen::MatrixXd A(2 * l.sightings.size(), 4);
-  forEachDltRowPair(l, P, R, T_b_c,
+  forEachDltRowPair(l, projection,
                     [&](std::size_t k, const Eigen::RowVector4d& r0, const Eigen::RowVector4d& r1) {
                       A.row(2 * k) = r0;
                       A.row(2 * k + 1) = r1;
@@ -105,11 +131,9 @@ double dltDepth(const PointLandmark& l, const std::vector<Eigen::Vector3d>& P,
 
 // The same least-squares solution from the 4x4 normal matrix A^T A: fixed-size and without
 // allocation, for the points triangulated again on every frame.
-double dltDepthFromNormalMatrix(const PointLandmark& l, const std::vector<Eigen::Vector3d>& P,
-                                const std::vector<Eigen::Matrix3d>& R,
-                                const Eigen::Isometry3d& T_b_c) {
+double dltDepthFromNormalMatrix(const PointLandmark& l, RelativeProjections& projection) {
   Eigen::Matrix4d AtA = Eigen::Matrix4d::Zero();
-  forEachDltRowPair(l, P, R, T_b_c,
+  forEachDltRowPair(l, projection,
                     [&](std::size_t, const Eigen::RowVector4d& r0, const Eigen::RowVector4d& r1) {
                       AtA.noalias() += r0.transpose() * r0 + r1.transpose() * r1;
                     });
@@ -123,9 +147,10 @@ double dltDepthFromNormalMatrix(const PointLandmark& l, const std::vector<Eigen:
 void PointLandmarks::triangulate(const std::vector<Eigen::Vector3d>& P,
                                  const std::vector<Eigen::Matrix3d>& R,
                                  const Eigen::Isometry3d& T_b_c) {
+  RelativeProjections projection(P, R, T_b_c);
   for (auto& [id, l] : landmarks_) {
     if (!l.usable(window_size_) || l.depth > 0) continue;
-    const double depth = dltDepth(l, P, R, T_b_c);
+    const double depth = dltDepth(l, projection);
     l.depth = depth < kMinTriangulatedDepth ? kDefaultDepth : depth;
     l.state = PointLandmark::State::kTriangulated;
   }
@@ -135,9 +160,10 @@ void PointLandmarks::retriangulate(const std::vector<Eigen::Vector3d>& P,
                                    const std::vector<Eigen::Matrix3d>& R,
                                    const Eigen::Isometry3d& T_b_c,
                                    const std::function<bool(const PointLandmark&)>& which) {
+  RelativeProjections projection(P, R, T_b_c);
   for (auto& [id, l] : landmarks_) {
     if (!l.usable(window_size_) || l.depth <= 0 || !which(l)) continue;
-    const double depth = dltDepthFromNormalMatrix(l, P, R, T_b_c);
+    const double depth = dltDepthFromNormalMatrix(l, projection);
     if (depth >= kMinTriangulatedDepth)
       l.depth = depth;  // a degenerate solution keeps the last depth
   }
