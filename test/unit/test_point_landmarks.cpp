@@ -97,6 +97,19 @@ TEST(PointLandmarks, RetriangulateKeepsTheDepthWhenTheSightingsDoNotPlaceThePoin
   EXPECT_DOUBLE_EQ(landmarks.landmarks().at(1).depth, 3.0);
 }
 
+TEST(PointLandmarks, RetriangulateKeepsTheDepthWhenTheSightingsPlaceThePointBehindTheCamera) {
+  std::vector<Eigen::Vector3d> P;
+  std::vector<Eigen::Matrix3d> R;
+  PointLandmark l = landmarkSeenAlongALine(Eigen::Vector3d(0.3, -0.2, -4.0), 5, &P, &R);
+  l.id = 1;
+  l.depth = 3.0;
+  PointLandmarks landmarks(10, kMinParallax);
+  landmarks.landmarks().emplace(1, l);
+  landmarks.retriangulate(P, R, Eigen::Isometry3d::Identity(),
+                          [](const PointLandmark&) { return true; });
+  EXPECT_DOUBLE_EQ(landmarks.landmarks().at(1).depth, 3.0);
+}
+
 // Landmarks first seen in different frames share the window's poses: each is placed from its
 // own first camera, whatever the others' (rotating body, camera offset from the body).
 TEST(PointLandmarks, EveryLandmarkIsTriangulatedFromItsOwnFirstCamera) {

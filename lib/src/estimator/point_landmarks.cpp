@@ -1,6 +1,5 @@
 #include "alvio/estimator/point_landmarks.h"
 
-#include <Eigen/Eigenvalues>
 #include <Eigen/SVD>
 
 namespace alvio {
@@ -129,17 +128,20 @@ double dltDepth(const PointLandmark& l, RelativeProjections& projection) {
   return X[2] / X[3];
 }
 
-// The same least-squares solution from the 4x4 normal matrix A^T A: fixed-size and without
-// allocation, for the points triangulated again on every frame.
-double dltDepthFromNormalMatrix(const PointLandmark& l, RelativeProjections& projection) {
-  Eigen::Matrix4d AtA = Eigen::Matrix4d::Zero();
+// Inverse depth along the anchor ray: with X = (xy1_0, rho) each DLT row r gives
+// r.head(3) . xy1_0 + r(3) rho = 0, solved for rho by least squares. The estimator keeps a
+// point on that ray anyway, and a 1-D solve is much cheaper than the 4x4 eigenproblem of the
+// free DLT; this runs for every left-out point on every frame. The anchor's own rows drop out
+// (their r(3) is zero). Returns 0 when the sightings have no baseline.
+double inverseDepthOnAnchorRay(const PointLandmark& l, RelativeProjections& projection) {
+  const Eigen::Vector3d& xy1 = l.sightings.front().xy1;
+  double ab = 0, bb = 0;
   forEachDltRowPair(l, projection,
                     [&](std::size_t, const Eigen::RowVector4d& r0, const Eigen::RowVector4d& r1) {
-                      AtA.noalias() += r0.transpose() * r0 + r1.transpose() * r1;
+                      ab += r0.head<3>().dot(xy1) * r0[3] + r1.head<3>().dot(xy1) * r1[3];
+                      bb += r0[3] * r0[3] + r1[3] * r1[3];
                     });
-  const Eigen::Vector4d X =
-      Eigen::SelfAdjointEigenSolver<Eigen::Matrix4d>(AtA).eigenvectors().col(0);
-  return X[2] / X[3];
+  return bb > 0 ? -ab / bb : 0.0;
 }
 
 }  // namespace
@@ -163,9 +165,9 @@ void PointLandmarks::retriangulate(const std::vector<Eigen::Vector3d>& P,
   RelativeProjections projection(P, R, T_b_c);
   for (auto& [id, l] : landmarks_) {
     if (!l.usable(window_size_) || l.depth <= 0 || !which(l)) continue;
-    const double depth = dltDepthFromNormalMatrix(l, projection);
-    if (depth >= kMinTriangulatedDepth)
-      l.depth = depth;  // a degenerate solution keeps the last depth
+    const double inverse_depth = inverseDepthOnAnchorRay(l, projection);
+    if (inverse_depth > 0 && 1.0 / inverse_depth >= kMinTriangulatedDepth)
+      l.depth = 1.0 / inverse_depth;  // a degenerate solution keeps the last depth
   }
 }
 

@@ -50,8 +50,9 @@ class PointLandmarks {
   /// Poses are body poses in the world; T_b_c the camera extrinsic.
   void triangulate(const std::vector<Eigen::Vector3d>& P, const std::vector<Eigen::Matrix3d>& R,
                    const Eigen::Isometry3d& T_b_c);
-  /// Triangulate again, at the current poses, the usable landmarks with a depth that `which`
-  /// names (those the optimiser leaves out keep a stale depth otherwise).
+  /// Triangulate again, at the current poses and along each one's first sighting's ray, the
+  /// usable landmarks with a depth that `which` names (those the optimiser leaves out keep a
+  /// stale depth otherwise). A degenerate or negative depth keeps the last one.
   void retriangulate(const std::vector<Eigen::Vector3d>& P, const std::vector<Eigen::Matrix3d>& R,
                      const Eigen::Isometry3d& T_b_c,
                      const std::function<bool(const PointLandmark&)>& which);
