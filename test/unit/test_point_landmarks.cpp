@@ -62,6 +62,19 @@ PointLandmark landmarkSeenAlongALine(const Eigen::Vector3d& p, int n,
   return l;
 }
 
+// The depth of `l`, started at `depth`, after retriangulate at the poses P, R.
+double depthAfterRetriangulation(PointLandmark l, double depth,
+                                 const std::vector<Eigen::Vector3d>& P,
+                                 const std::vector<Eigen::Matrix3d>& R) {
+  l.id = 1;
+  l.depth = depth;
+  PointLandmarks landmarks(10, kMinParallax);
+  landmarks.landmarks().emplace(1, l);
+  landmarks.retriangulate(P, R, Eigen::Isometry3d::Identity(),
+                          [](const PointLandmark&) { return true; });
+  return landmarks.landmarks().at(1).depth;
+}
+
 }  // namespace
 
 TEST(PointLandmarks, RetriangulateRefreshesOnlyTheNamedLandmarksDepths) {
@@ -88,26 +101,14 @@ TEST(PointLandmarks, RetriangulateKeepsTheDepthWhenTheSightingsDoNotPlaceThePoin
   PointLandmark l = landmarkSeenAlongALine(Eigen::Vector3d(0.3, -0.2, 4.0), 5, &P, &R);
   for (auto& p : P) p.setZero();
   for (auto& s : l.sightings) s.xy1 = Eigen::Vector3d(0.3 / 4, -0.2 / 4, 1);
-  l.id = 1;
-  l.depth = 3.0;
-  PointLandmarks landmarks(10, kMinParallax);
-  landmarks.landmarks().emplace(1, l);
-  landmarks.retriangulate(P, R, Eigen::Isometry3d::Identity(),
-                          [](const PointLandmark&) { return true; });
-  EXPECT_DOUBLE_EQ(landmarks.landmarks().at(1).depth, 3.0);
+  EXPECT_DOUBLE_EQ(depthAfterRetriangulation(l, 3.0, P, R), 3.0);
 }
 
 TEST(PointLandmarks, RetriangulateKeepsTheDepthWhenTheSightingsPlaceThePointBehindTheCamera) {
   std::vector<Eigen::Vector3d> P;
   std::vector<Eigen::Matrix3d> R;
-  PointLandmark l = landmarkSeenAlongALine(Eigen::Vector3d(0.3, -0.2, -4.0), 5, &P, &R);
-  l.id = 1;
-  l.depth = 3.0;
-  PointLandmarks landmarks(10, kMinParallax);
-  landmarks.landmarks().emplace(1, l);
-  landmarks.retriangulate(P, R, Eigen::Isometry3d::Identity(),
-                          [](const PointLandmark&) { return true; });
-  EXPECT_DOUBLE_EQ(landmarks.landmarks().at(1).depth, 3.0);
+  const PointLandmark l = landmarkSeenAlongALine(Eigen::Vector3d(0.3, -0.2, -4.0), 5, &P, &R);
+  EXPECT_DOUBLE_EQ(depthAfterRetriangulation(l, 3.0, P, R), 3.0);
 }
 
 // Landmarks first seen in different frames share the window's poses: each is placed from its
