@@ -499,8 +499,9 @@ def main():
                     "(refused while a build is running), so that a rebuild during the runs or "
                     "the rendering cannot break them")
     ap.add_argument("--render", action="store_true",
-                    help="render missing sequences first (alvio sim --benchmark; with --freeze, "
-                    "the frozen alvio_sim)")
+                    help="render missing sequences first (alvio sim --benchmark, which keeps "
+                    "what is up to date; with --freeze, the frozen alvio_sim); ./alvio "
+                    "ablation always passes it")
     a = ap.parse_args()
     if a.repeats < 1:
         sys.exit("alvio bench: error: --repeats must be at least 1")
@@ -576,9 +577,11 @@ def main():
     else:
         config_dir = ROOT / "config"
     if a.render:
+        # Only sequence names: a folder given is the user's own, and an empty --only would
+        # render the whole set.
         names = [s for s in seqs if not Path(s).is_dir()]
         sim = Path(a.bin).with_name("alvio_sim")
-        for seed in seeds:
+        for seed in seeds if names else []:
             subprocess.run([str(sim), "--benchmark", str(seed_set(seed)), "--seed", str(seed),
                             "--only", ",".join(names), "--config", str(config_dir / "euroc.yaml")],
                            check=True, env=program_env(sim))

@@ -641,6 +641,16 @@ class MainTest(unittest.TestCase):
             self.assertTrue(c["ld_library_path"].startswith(str(out / "frozen" / "lib")))
         self.assertTrue((out / "sim_A" / "lines" / "s3" / "summary.json").exists())
 
+    def test_render_leaves_sequences_given_as_folders_alone(self):
+        # ./alvio ablation always renders what is missing: a folder of one's own is not
+        # the simulator's to make (an empty --only would render the whole set).
+        run = self.fake_build()
+        p = self.bench("--bin", str(run), "--render", "--sequences", str(self.data / "sim_A"),
+                       "--variants", "lines")
+        self.assertEqual(p.returncode, 0, p.stderr)
+        self.assertFalse((self.data / "sim_calls.jsonl").exists())
+        self.assertTrue((self.dir / "out" / "sim_A" / "lines" / "summary.json").exists())
+
     def test_missing_sequence_names_it(self):
         p = self.bench("--sequences", "sim_nowhere")
         self.assertNotEqual(p.returncode, 0)
