@@ -499,9 +499,9 @@ def main():
                     "(refused while a build is running), so that a rebuild during the runs or "
                     "the rendering cannot break them")
     ap.add_argument("--render", action="store_true",
-                    help="render missing sequences first (alvio sim --benchmark, which keeps "
-                    "what is up to date; with --freeze, the frozen alvio_sim); ./alvio "
-                    "ablation always passes it")
+                    help="render missing or out-of-date sequences first (alvio sim --benchmark, "
+                    "which keeps what is up to date; with --freeze, the frozen alvio_sim); "
+                    "./alvio ablation always passes it")
     a = ap.parse_args()
     if a.repeats < 1:
         sys.exit("alvio bench: error: --repeats must be at least 1")
