@@ -74,6 +74,8 @@ with open(data / "sim_calls.jsonl", "a") as f:
     f.write(json.dumps({"argv": argv, "ld_library_path": os.environ.get("LD_LIBRARY_PATH", "")}))
     f.write("\\n")
 for name in argv[argv.index("--only") + 1].split(","):
+    if name == "sim_nowhere":  # as the real one: an unknown name is an error
+        sys.exit("alvio sim: error: unknown benchmark sequence 'sim_nowhere'")
     (root / name / "mav0").mkdir(parents=True, exist_ok=True)
 """
 
@@ -650,6 +652,13 @@ class MainTest(unittest.TestCase):
         self.assertEqual(p.returncode, 0, p.stderr)
         self.assertFalse((self.data / "sim_calls.jsonl").exists())
         self.assertTrue((self.dir / "out" / "sim_A" / "lines" / "summary.json").exists())
+
+    def test_render_of_an_unknown_sequence_fails_without_a_traceback(self):
+        p = self.bench("--bin", str(self.fake_build()), "--render", "--sequences", "sim_nowhere")
+        self.assertNotEqual(p.returncode, 0)
+        self.assertIn("unknown benchmark sequence 'sim_nowhere'", p.stderr)
+        self.assertIn("alvio bench: rendering", p.stderr)
+        self.assertNotIn("Traceback", p.stderr)
 
     def test_missing_sequence_names_it(self):
         p = self.bench("--sequences", "sim_nowhere")
