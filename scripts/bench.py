@@ -581,13 +581,15 @@ def main():
         # render the whole set.
         names = [s for s in seqs if not Path(s).is_dir()]
         sim = Path(a.bin).with_name("alvio_sim")
-        for seed in seeds if names else []:
-            rendered = subprocess.run([str(sim), "--benchmark", str(seed_set(seed)), "--seed",
-                                       str(seed), "--only", ",".join(names), "--config",
-                                       str(config_dir / "euroc.yaml")], env=program_env(sim))
-            if rendered.returncode != 0:  # the simulator has said why
-                sys.exit(f"alvio bench: rendering {','.join(names)} into {seed_set(seed)} "
-                         f"failed (alvio sim exit {rendered.returncode})")
+        if names:
+            for seed in seeds:
+                rendered = subprocess.run(
+                    [str(sim), "--benchmark", str(seed_set(seed)), "--seed", str(seed), "--only",
+                     ",".join(names), "--config", str(config_dir / "euroc.yaml")],
+                    env=program_env(sim))
+                if rendered.returncode != 0:  # the simulator has said why
+                    sys.exit(f"alvio bench: rendering {','.join(names)} into {seed_set(seed)} "
+                             f"failed (alvio sim exit {rendered.returncode})")
         datasets = sequence_folders()
 
     def with_config(name, args):

@@ -644,8 +644,8 @@ class MainTest(unittest.TestCase):
         self.assertTrue((out / "sim_A" / "lines" / "s3" / "summary.json").exists())
 
     def test_render_leaves_sequences_given_as_folders_alone(self):
-        # ./alvio ablation always renders what is missing: a folder of one's own is not
-        # the simulator's to make (an empty --only would render the whole set).
+        # ./alvio ablation always renders what is missing or out of date: a folder of one's
+        # own is not the simulator's to make (an empty --only would render the whole set).
         run = self.fake_build()
         p = self.bench("--bin", str(run), "--render", "--sequences", str(self.data / "sim_A"),
                        "--variants", "lines")
