@@ -115,6 +115,60 @@ TEST(LineDetector, LargerLsdQuantSkipsFaintEdges) {
   EXPECT_EQ(edgesAt(8.0), (std::set<int>{500}));
 }
 
+TEST(LineDetector, AReferenceBrightnessKeepsADimFramesFaintEdges) {
+  // A faint step (12 grey levels) at x = 250 and a strong one at x = 500, and the same frame
+  // at 35 % of the light, where the faint step is 4 levels.
+  cv::Mat bright(kSize, CV_8UC1, cv::Scalar(100));
+  bright.colRange(250, 500).setTo(112);
+  bright.colRange(500, kSize.width).setTo(200);
+  cv::Mat dim;
+  bright.convertTo(dim, CV_8UC1, 0.35);
+  const double reference = cv::mean(bright)[0];
+  const auto verticalEdges = [](const std::vector<LineSegment>& segments) {
+    std::set<int> xs;
+    for (const LineSegment& s : segments)
+      if (std::abs(s.start.x() - s.end.x()) < 2 && s.length() > 200)
+        xs.insert(static_cast<int>(std::lround(s.midpoint().x() / 10) * 10));
+    return xs;
+  };
+  LineDetectorOptions o;
+  LineDetector fixed(o, kSize);
+  EXPECT_EQ(verticalEdges(fixed.detect(bright)), (std::set<int>{250, 500}));
+  EXPECT_EQ(verticalEdges(fixed.detect(dim)), (std::set<int>{500}));  // what dim light loses
+
+  o.lsd_reference_brightness = reference;
+  LineDetector following(o, kSize);
+  EXPECT_EQ(verticalEdges(following.detect(dim)), (std::set<int>{250, 500}));
+  EXPECT_NEAR(following.lastQuant(), o.lsd_quant * cv::mean(dim)[0] / reference, 1e-12);
+  // A frame as bright as the reference is detected exactly as without it.
+  const auto a = fixed.detect(bright), b = following.detect(bright);
+  EXPECT_EQ(following.lastQuant(), o.lsd_quant);
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].start, b[i].start);
+    EXPECT_EQ(a[i].end, b[i].end);
+  }
+  // A black frame's threshold stops at lsd_min_quant_scale.
+  following.detect(cv::Mat(kSize, CV_8UC1, cv::Scalar(0)));
+  EXPECT_EQ(following.lastQuant(), o.lsd_quant * o.lsd_min_quant_scale);
+}
+
+TEST(LineDetector, AReferenceBrightnessNeedsLsdAndAGreyLevel) {
+  LineDetectorOptions o;
+  o.lsd_reference_brightness = 300;
+  EXPECT_NE(test::errorOf([&] { o.validate("lines.detector"); }).find("lsd_reference_brightness"),
+            std::string::npos);
+  o.lsd_reference_brightness = 110;
+  EXPECT_NO_THROW(o.validate("lines.detector"));
+  o.method = "opencv_lsd";
+  EXPECT_NE(test::errorOf([&] { o.validate("lines.detector"); }).find("lsd_reference_brightness"),
+            std::string::npos);
+  o.method = "lsd";
+  o.lsd_min_quant_scale = 0;
+  EXPECT_NE(test::errorOf([&] { o.validate("lines.detector"); }).find("lsd_min_quant_scale"),
+            std::string::npos);
+}
+
 TEST(LineDetector, LsdOnAScaledImageFindsStepEdgesWhereTheyAre) {
   // A bright quadrant x > ex, y > ey, pixels shaded by the area they cover (pixel u spans
   // [u - 0.5, u + 0.5]), at ten sub-pixel positions. Before the scale shift, lsd_scale 0.5

@@ -9,7 +9,7 @@
 namespace alvio {
 
 LineDetector::LineDetector(const LineDetectorOptions& options, cv::Size image_size)
-    : options_(options) {
+    : options_(options), last_quant_(options.lsd_quant) {
   options_.validate("line detector");
   min_length_ = options_.min_length_ratio * std::hypot(image_size.width, image_size.height);
   // OpenCV's LSD: its defaults apart from the scale, sigma, quant and refinement (angle
@@ -39,6 +39,16 @@ void shift(std::vector<cv::Vec4f>* raw, float c) {
 }
 }  // namespace
 
+double LineDetector::quantFor(const cv::Mat& gray, const cv::Mat& valid_mask) {
+  // Gradients scale with the light: in a frame at a fraction of the reference brightness an
+  // edge is that fraction as steep, so the threshold follows.
+  const double mean = valid_mask.empty() ? cv::mean(gray)[0] : cv::mean(gray, valid_mask)[0];
+  const double scale =
+      std::clamp(mean / options_.lsd_reference_brightness, options_.lsd_min_quant_scale, 1.0);
+  last_quant_ = options_.lsd_quant * scale;
+  return last_quant_;
+}
+
 std::vector<LineSegment> LineDetector::detect(const cv::Mat& gray, const cv::Mat& valid_mask) {
   std::vector<cv::Vec4f> raw;
   if (fld_ && options_.fld_scale < 1) {
@@ -52,7 +62,10 @@ std::vector<LineSegment> LineDetector::detect(const cv::Mat& gray, const cv::Mat
   } else {
     // Both LSDs return u_s / s for a scaled run: without the shift every segment sat 0.5 px up
     // and left of its edge at lsd_scale 0.5 (test_line_tracker).
-    if (lsd_)
+    if (lsd_ && options_.lsd_reference_brightness > 0) {
+      lsd_->setQuant(quantFor(gray, valid_mask));
+      lsd_->detect(gray, &raw);
+    } else if (lsd_)
       lsd_->detect(gray, &raw);
     else
       opencv_lsd_->detect(gray, raw);

@@ -40,6 +40,9 @@ LineDetectorOptions LineDetectorOptions::load(const YamlReader& yaml, const std:
   o.lsd_pyramid_downscale = yaml.getBool(p + "lsd_pyramid_downscale", o.lsd_pyramid_downscale);
   o.lsd_refine = yaml.getBool(p + "lsd_refine", o.lsd_refine);
   o.lsd_quant = yaml.getDouble(p + "lsd_quant", o.lsd_quant);
+  o.lsd_reference_brightness =
+      yaml.getDouble(p + "lsd_reference_brightness", o.lsd_reference_brightness);
+  o.lsd_min_quant_scale = yaml.getDouble(p + "lsd_min_quant_scale", o.lsd_min_quant_scale);
   o.border_margin_px = yaml.getInt(p + "border_margin_px", o.border_margin_px);
   o.refine_edges = yaml.getBool(p + "refine_edges", o.refine_edges);
   o.validate(whereOf(yaml, prefix));
@@ -63,6 +66,13 @@ void LineDetectorOptions::validate(const std::string& where) const {
   require(fld_scale > 0 && fld_scale <= 1, where, "fld_scale", "in (0, 1]", fld_scale);
   require(lsd_sigma_scale > 0, where, "lsd_sigma_scale", "positive", lsd_sigma_scale);
   require(lsd_quant > 0, where, "lsd_quant", "positive", lsd_quant);
+  require(lsd_reference_brightness >= 0 && lsd_reference_brightness <= 255, where,
+          "lsd_reference_brightness", "in [0, 255]", lsd_reference_brightness);
+  require(lsd_min_quant_scale > 0 && lsd_min_quant_scale <= 1, where, "lsd_min_quant_scale",
+          "in (0, 1]", lsd_min_quant_scale);
+  if (lsd_reference_brightness > 0 && method != "lsd")
+    throw Error(where + ": key 'lsd_reference_brightness' needs method lsd (got method '" + method +
+                "')");
   require(border_margin_px >= 0, where, "border_margin_px", "non-negative", border_margin_px);
 }
 

@@ -44,6 +44,11 @@ LinearTimeLsd::LinearTimeLsd(double scale, double sigma_scale, double quant, boo
     }
 }
 
+void LinearTimeLsd::setQuant(double quant) {
+  CV_Assert(quant > 0);
+  threshold_ = quant / std::sin(kTolerance);
+}
+
 void LinearTimeLsd::detect(const cv::Mat& gray, std::vector<cv::Vec4f>* segments) {
   CV_Assert(!gray.empty() && gray.type() == CV_8UC1);
   segments->clear();

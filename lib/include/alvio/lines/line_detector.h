@@ -29,10 +29,16 @@ class LineDetector {
   /// Minimum length of any returned segment (continuations, pieces of split lines) [px].
   double shortestLength() const { return min_length_ * options_.continuation_length_factor; }
   const LineDetectorOptions& options() const { return options_; }
+  /// LSD's quant in the last detect() (lsd_quant unless lsd_reference_brightness lowered it).
+  double lastQuant() const { return last_quant_; }
 
  private:
+  /// lsd_quant scaled for the frame's mean brightness (lsd_reference_brightness).
+  double quantFor(const cv::Mat& gray, const cv::Mat& valid_mask);
+
   LineDetectorOptions options_;
   double min_length_;
+  double last_quant_;
   std::unique_ptr<LinearTimeLsd> lsd_;
   cv::Ptr<cv::LineSegmentDetector> opencv_lsd_;
   cv::Ptr<cv::ximgproc::FastLineDetector> fld_;

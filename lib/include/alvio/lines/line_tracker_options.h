@@ -47,6 +47,12 @@ struct LineDetectorOptions {
   /// LSD's bound on the gradient's quantisation error (OpenCV's `quant`): pixels whose
   /// gradient is under quant / sin(22.5 deg) grow no region. Larger skips faint edges.
   double lsd_quant = 2.0;
+  /// Mean grey level [0, 255] at which lsd_quant holds (0: always). A darker frame's threshold
+  /// is scaled by its mean / this, down to lsd_min_quant_scale: LSD then keeps the edges it
+  /// would find in the frame brightened to this level, which dim light would otherwise lose.
+  /// Frames at least this bright are unchanged. Method lsd only.
+  double lsd_reference_brightness = 0.0;
+  double lsd_min_quant_scale = 0.25;
   /// Segments must keep this distance [px] from the invalid (unmapped) border of the
   /// undistorted image.
   int border_margin_px = 2;

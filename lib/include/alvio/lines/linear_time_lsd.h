@@ -32,6 +32,9 @@ class LinearTimeLsd {
   /// `gray` is CV_8UC1.
   void detect(const cv::Mat& gray, std::vector<cv::Vec4f>* segments);
 
+  /// Changes `quant` for the next detect() (the threshold is quant / sin(22.5 deg)).
+  void setQuant(double quant);
+
  private:
   struct RegionPixel {
     int x, y;
