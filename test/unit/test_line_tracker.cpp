@@ -748,7 +748,8 @@ TEST(ImageUndistorter, GivesCvRemapsImageBitForBitBorderIncluded) {
 
 TEST(LineTrackerOptions, LoadFromYamlAndNameBadKeys) {
   const auto yaml = YamlReader::fromString(
-      "lines:\n  tracker: descriptor\n  detector: {max_lines: 25, lsd_scale: 0.8, lsd_quant: 4}\n"
+      "lines:\n  tracker: descriptor\n  detector: {max_lines: 25, lsd_scale: 0.8, lsd_quant: 4,\n"
+      "    lsd_reference_brightness: 90, lsd_min_quant_scale: 0.5}\n"
       "  flow: {samples_per_line: 7, detect_every: 3}\n",
       "test.yaml");
   const LineTrackerOptions o = LineTrackerOptions::load(yaml, "lines");
@@ -756,6 +757,8 @@ TEST(LineTrackerOptions, LoadFromYamlAndNameBadKeys) {
   EXPECT_EQ(o.detector.max_lines, 25);
   EXPECT_DOUBLE_EQ(o.detector.lsd_scale, 0.8);
   EXPECT_DOUBLE_EQ(o.detector.lsd_quant, 4.0);
+  EXPECT_DOUBLE_EQ(o.detector.lsd_reference_brightness, 90.0);
+  EXPECT_DOUBLE_EQ(o.detector.lsd_min_quant_scale, 0.5);
   EXPECT_DOUBLE_EQ(o.detector.min_length_ratio, 0.06);
   EXPECT_EQ(o.flow.samples_per_line, 7);
   EXPECT_EQ(o.flow.detect_every, 3);
