@@ -131,39 +131,43 @@ TEST(LineDetector, AReferenceBrightnessKeepsADimFramesFaintEdges) {
         xs.insert(static_cast<int>(std::lround(s.midpoint().x() / 10) * 10));
     return xs;
   };
-  LineDetectorOptions o;
-  LineDetector fixed(o, kSize);
-  EXPECT_EQ(verticalEdges(fixed.detect(bright)), (std::set<int>{250, 500}));
-  EXPECT_EQ(verticalEdges(fixed.detect(dim)), (std::set<int>{500}));  // what dim light loses
+  for (const char* method : {"lsd", "opencv_lsd"}) {
+    SCOPED_TRACE(method);
+    LineDetectorOptions o;
+    o.method = method;
+    LineDetector fixed(o, kSize);
+    EXPECT_EQ(verticalEdges(fixed.detect(bright)), (std::set<int>{250, 500}));
+    EXPECT_EQ(verticalEdges(fixed.detect(dim)), (std::set<int>{500}));  // what dim light loses
 
-  o.lsd_reference_brightness = reference;
-  LineDetector following(o, kSize);
-  EXPECT_EQ(verticalEdges(following.detect(dim)), (std::set<int>{250, 500}));
-  EXPECT_NEAR(following.lastQuant(), o.lsd_quant * cv::mean(dim)[0] / reference, 1e-12);
-  // A frame as bright as the reference is detected exactly as without it.
-  const auto a = fixed.detect(bright), b = following.detect(bright);
-  EXPECT_EQ(following.lastQuant(), o.lsd_quant);
-  ASSERT_EQ(a.size(), b.size());
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    EXPECT_EQ(a[i].start, b[i].start);
-    EXPECT_EQ(a[i].end, b[i].end);
+    o.lsd_reference_brightness = reference;
+    LineDetector following(o, kSize);
+    EXPECT_EQ(verticalEdges(following.detect(dim)), (std::set<int>{250, 500}));
+    EXPECT_NEAR(following.lastQuant(), o.lsd_quant * cv::mean(dim)[0] / reference, 1e-12);
+    // A frame as bright as the reference is detected exactly as without it.
+    const auto a = fixed.detect(bright), b = following.detect(bright);
+    EXPECT_EQ(following.lastQuant(), o.lsd_quant);
+    ASSERT_EQ(a.size(), b.size());
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      EXPECT_EQ(a[i].start, b[i].start);
+      EXPECT_EQ(a[i].end, b[i].end);
+    }
+    // A black frame's threshold stops at lsd_min_quant_scale.
+    following.detect(cv::Mat(kSize, CV_8UC1, cv::Scalar(0)));
+    EXPECT_EQ(following.lastQuant(), o.lsd_quant * o.lsd_min_quant_scale);
   }
-  // A black frame's threshold stops at lsd_min_quant_scale.
-  following.detect(cv::Mat(kSize, CV_8UC1, cv::Scalar(0)));
-  EXPECT_EQ(following.lastQuant(), o.lsd_quant * o.lsd_min_quant_scale);
 }
 
-TEST(LineDetector, AReferenceBrightnessNeedsLsdAndAGreyLevel) {
+TEST(LineDetector, AReferenceBrightnessIsAGreyLevel) {
   LineDetectorOptions o;
   o.lsd_reference_brightness = 300;
   EXPECT_NE(test::errorOf([&] { o.validate("lines.detector"); }).find("lsd_reference_brightness"),
             std::string::npos);
+  // Every method takes it (FLD has no gradient threshold and ignores it, as the other lsd_ keys).
   o.lsd_reference_brightness = 110;
-  EXPECT_NO_THROW(o.validate("lines.detector"));
-  o.method = "opencv_lsd";
-  EXPECT_NE(test::errorOf([&] { o.validate("lines.detector"); }).find("lsd_reference_brightness"),
-            std::string::npos);
-  o.method = "lsd";
+  for (const char* method : {"lsd", "opencv_lsd", "fld"}) {
+    o.method = method;
+    EXPECT_NO_THROW(o.validate("lines.detector")) << method;
+  }
   o.lsd_min_quant_scale = 0;
   EXPECT_NE(test::errorOf([&] { o.validate("lines.detector"); }).find("lsd_min_quant_scale"),
             std::string::npos);

@@ -20,9 +20,7 @@ LineDetector::LineDetector(const LineDetectorOptions& options, cv::Size image_si
     fld_ = cv::ximgproc::createFastLineDetector(
         static_cast<int>(shortestLength() * options_.fld_scale), 1.41421356f, 50.0, 50.0, 3, false);
   else if (options_.method == "opencv_lsd")
-    opencv_lsd_ = cv::createLineSegmentDetector(
-        options_.lsd_refine ? cv::LSD_REFINE_STD : cv::LSD_REFINE_NONE, options_.lsd_scale,
-        options_.lsd_sigma_scale, options_.lsd_quant);
+    opencv_lsd_ = makeOpenCvLsd(options_.lsd_quant);
   else
     lsd_ = std::make_unique<LinearTimeLsd>(options_.lsd_scale, options_.lsd_sigma_scale,
                                            options_.lsd_quant, options_.lsd_pyramid_downscale);
@@ -38,6 +36,12 @@ void shift(std::vector<cv::Vec4f>* raw, float c) {
   for (cv::Vec4f& r : *raw) r += cv::Vec4f(c, c, c, c);
 }
 }  // namespace
+
+cv::Ptr<cv::LineSegmentDetector> LineDetector::makeOpenCvLsd(double quant) const {
+  return cv::createLineSegmentDetector(
+      options_.lsd_refine ? cv::LSD_REFINE_STD : cv::LSD_REFINE_NONE, options_.lsd_scale,
+      options_.lsd_sigma_scale, quant);
+}
 
 double LineDetector::quantFor(const cv::Mat& gray, const cv::Mat& valid_mask) {
   // Gradients scale with the light: in a frame at a fraction of the reference brightness an
@@ -62,10 +66,15 @@ std::vector<LineSegment> LineDetector::detect(const cv::Mat& gray, const cv::Mat
   } else {
     // Both LSDs return u_s / s for a scaled run: without the shift every segment sat 0.5 px up
     // and left of its edge at lsd_scale 0.5 (test_line_tracker).
-    if (lsd_ && options_.lsd_reference_brightness > 0) {
-      lsd_->setQuant(quantFor(gray, valid_mask));
-      lsd_->detect(gray, &raw);
-    } else if (lsd_)
+    if (options_.lsd_reference_brightness > 0) {
+      const double previous = last_quant_;
+      const double quant = quantFor(gray, valid_mask);
+      if (lsd_)
+        lsd_->setQuant(quant);
+      else if (quant != previous)  // OpenCV's LSD takes its quant only when it is made
+        opencv_lsd_ = makeOpenCvLsd(quant);
+    }
+    if (lsd_)
       lsd_->detect(gray, &raw);
     else
       opencv_lsd_->detect(gray, raw);

@@ -70,9 +70,6 @@ void LineDetectorOptions::validate(const std::string& where) const {
           "lsd_reference_brightness", "in [0, 255]", lsd_reference_brightness);
   require(lsd_min_quant_scale > 0 && lsd_min_quant_scale <= 1, where, "lsd_min_quant_scale",
           "in (0, 1]", lsd_min_quant_scale);
-  if (lsd_reference_brightness > 0 && method != "lsd")
-    throw Error(where + ": key 'lsd_reference_brightness' needs method lsd (got method '" + method +
-                "')");
   require(border_margin_px >= 0, where, "border_margin_px", "non-negative", border_margin_px);
 }
 

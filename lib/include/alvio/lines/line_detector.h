@@ -35,6 +35,7 @@ class LineDetector {
  private:
   /// lsd_quant scaled for the frame's mean brightness (lsd_reference_brightness).
   double quantFor(const cv::Mat& gray, const cv::Mat& valid_mask);
+  cv::Ptr<cv::LineSegmentDetector> makeOpenCvLsd(double quant) const;
 
   LineDetectorOptions options_;
   double min_length_;

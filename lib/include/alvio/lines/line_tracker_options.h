@@ -50,7 +50,7 @@ struct LineDetectorOptions {
   /// Mean grey level [0, 255] at which lsd_quant holds (0: always). A darker frame's threshold
   /// is scaled by its mean / this, down to lsd_min_quant_scale: LSD then keeps the edges it
   /// would find in the frame brightened to this level, which dim light would otherwise lose.
-  /// Frames at least this bright are unchanged. Method lsd only.
+  /// Frames at least this bright are unchanged. Both LSDs; FLD has no such threshold.
   double lsd_reference_brightness = 0.0;
   double lsd_min_quant_scale = 0.25;
   /// Segments must keep this distance [px] from the invalid (unmapped) border of the
