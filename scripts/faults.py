@@ -143,6 +143,17 @@ def illumination(gain):
     return mutate
 
 
+def fade(gain, seconds):
+    # A slow change passes the exposure compensation (a few tenths of a percent a frame), so
+    # both trackers see the dark frames as they are.
+    def mutate(ctx, topic, msg, t):
+        if topic == IMAGE_TOPIC and ctx.inside(stamp_s(msg)):
+            done = min(1.0, (stamp_s(msg) - ctx.t_fault) / seconds)
+            scaled(msg, 1.0 - (1.0 - gain) * done)
+        return [(topic, msg, t)]
+    return mutate
+
+
 def flicker(ctx, topic, msg, t):
     # Mains flicker aliased by the camera: the gain swings between 0.4 and 1.0 at 6 Hz.
     if topic == IMAGE_TOPIC and ctx.inside(stamp_s(msg)):
@@ -192,6 +203,8 @@ FAULTS = [
     Fault("black_then_saturated", "1 s of black frames, then 1 s of saturated frames", 2.0,
           black_then_saturated),
     Fault("illumination_x0.3", "the light drops to 30 % for good", math.inf, illumination(0.3)),
+    Fault("fade_to_0.3", "the light fades to 30 % over 5 s and stays there", math.inf,
+          fade(0.3, 5.0)),
     Fault("flicker", "3 s of flicker (gain 0.4 to 1.0 at 6 Hz)", 3.0, flicker),
     Fault("fast_rotation", "a 360-degree yaw spin in 1 s (peak 540 deg/s), rendered", 1.0, None,
           rendered=True),
