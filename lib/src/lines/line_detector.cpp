@@ -43,14 +43,12 @@ cv::Ptr<cv::LineSegmentDetector> LineDetector::makeOpenCvLsd(double quant) const
       options_.lsd_sigma_scale, quant);
 }
 
-double LineDetector::quantFor(const cv::Mat& gray, const cv::Mat& valid_mask) {
+double LineDetector::quantFor(const cv::Mat& gray, const cv::Mat& valid_mask) const {
   // Gradients scale with the light: in a frame at a fraction of the reference brightness an
   // edge is that fraction as steep, so the threshold follows.
   const double mean = valid_mask.empty() ? cv::mean(gray)[0] : cv::mean(gray, valid_mask)[0];
-  const double scale =
-      std::clamp(mean / options_.lsd_reference_brightness, options_.lsd_min_quant_scale, 1.0);
-  last_quant_ = options_.lsd_quant * scale;
-  return last_quant_;
+  return options_.lsd_quant *
+         std::clamp(mean / options_.lsd_reference_brightness, options_.lsd_min_quant_scale, 1.0);
 }
 
 std::vector<LineSegment> LineDetector::detect(const cv::Mat& gray, const cv::Mat& valid_mask) {
@@ -67,12 +65,12 @@ std::vector<LineSegment> LineDetector::detect(const cv::Mat& gray, const cv::Mat
     // Both LSDs return u_s / s for a scaled run: without the shift every segment sat 0.5 px up
     // and left of its edge at lsd_scale 0.5 (test_line_tracker).
     if (options_.lsd_reference_brightness > 0) {
-      const double previous = last_quant_;
       const double quant = quantFor(gray, valid_mask);
       if (lsd_)
         lsd_->setQuant(quant);
-      else if (quant != previous)  // OpenCV's LSD takes its quant only when it is made
+      else if (quant != last_quant_)  // OpenCV's LSD takes its quant only when it is made
         opencv_lsd_ = makeOpenCvLsd(quant);
+      last_quant_ = quant;
     }
     if (lsd_)
       lsd_->detect(gray, &raw);

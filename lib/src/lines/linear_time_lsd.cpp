@@ -20,10 +20,9 @@ constexpr float kNotComputed = std::numeric_limits<float>::quiet_NaN();
 }  // namespace
 
 LinearTimeLsd::LinearTimeLsd(double scale, double sigma_scale, double quant, bool pyramid_downscale)
-    : scale_(scale),
-      threshold_(quant / std::sin(kTolerance)),
-      pyramid_downscale_(pyramid_downscale) {
-  CV_Assert(scale > 0 && scale <= 1 && sigma_scale > 0 && quant > 0);
+    : scale_(scale), pyramid_downscale_(pyramid_downscale) {
+  CV_Assert(scale > 0 && scale <= 1 && sigma_scale > 0);
+  setQuant(quant);
   CV_Assert(!pyramid_downscale || scale == 0.5);
   if (scale != 1 && !pyramid_downscale) {
     // The blur that keeps the scaled image free of aliasing: sigma = sigma_scale / scale,

@@ -34,7 +34,7 @@ class LineDetector {
 
  private:
   /// lsd_quant scaled for the frame's mean brightness (lsd_reference_brightness).
-  double quantFor(const cv::Mat& gray, const cv::Mat& valid_mask);
+  double quantFor(const cv::Mat& gray, const cv::Mat& valid_mask) const;
   cv::Ptr<cv::LineSegmentDetector> makeOpenCvLsd(double quant) const;
 
   LineDetectorOptions options_;
