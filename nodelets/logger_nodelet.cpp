@@ -14,11 +14,14 @@
 
 #include <alvio/PipelineStatus.h>
 
+#include <cstdio>
 #include <filesystem>
 #include <memory>
 #include <sstream>
 
+#include "alvio/common/clock_jump.h"
 #include "alvio/common/error.h"
+#include "alvio/logging/fresh_log_names.h"
 #include "alvio/logging/mrpt_logger.h"
 #include "conversions.h"
 #include "core_log_route.h"
@@ -30,15 +33,7 @@ namespace alvio_ros {
 
 class LoggerNodelet : public GuardedNodelet {
  public:
-  ~LoggerNodelet() override {
-    log_route_.clearListener();
-    if (!logger_) return;
-    logger_->flushStats();
-    logger_->log(alvio::LogLevel::kInfo, "shutting down: " + std::to_string(frames_) + " frames, " +
-                                             std::to_string(poses_) + " poses");
-    const alvio::MapSnapshot map = snapshot();
-    logger_->finish(&map);
-  }
+  ~LoggerNodelet() override { closeLog("shutting down"); }
 
  private:
   void init() override {
@@ -47,26 +42,26 @@ class LoggerNodelet : public GuardedNodelet {
     const NodeletConfig config(nh, pnh);
     config.rejectUnusedOverrides();
     const alvio::Config& c = config.config();
-    const std::string output_dir = param(pnh, "output_dir", c.logger.out_dir);
+    // The launch files pass "" when no output_dir is given: the config's folder then.
+    output_dir_ = param(pnh, "output_dir", std::string());
+    if (output_dir_.empty()) output_dir_ = c.logger.out_dir;
     const std::string imu_topic = param(pnh, "imu_topic", c.topics.imu);
     const std::string frame_topic = param(pnh, "frame_topic", "tracker/frame");
     const std::string estimator_ns = param(pnh, "estimator", "estimator");
-    requireParam(!output_dir.empty(), pnh, "output_dir",
+    requireParam(!output_dir_.empty(), pnh, "output_dir",
                  "is not set (nor logger.out_dir in the configuration): nowhere to log");
     c.logger.validate(config.describe() + ": logger");
-    logger_ =
-        std::make_unique<alvio::MrptLogger>(freshNames(c.logger, output_dir), c.camera, output_dir);
+    options_ = c.logger;
+    options_.out_dir = output_dir_;  // the parameter wins over the config
+    camera_ = c.camera;
 
     std::ostringstream os;
     os << "alvio nodelets\n  config: " << config.describe()
        << "\n  camera: " << c.camera.distortion_model << " " << c.camera.width << "x"
        << c.camera.height << " @ " << c.camera.rate_hz << " Hz\n  topics: " << imu_topic << ", "
        << frame_topic << ", " << estimator_ns << "/{odometry,status,window,points,lines}";
-    logger_->log(alvio::LogLevel::kInfo, os.str());
-    alvio::MrptLogger* logger = logger_.get();
-    log_route_.setListener([logger](alvio::LogLevel level, const std::string& message) {
-      logger->log(level, message);
-    });
+    header_ = os.str();
+    openLog(header_);
 
     imu_sub_ = nh.subscribe(imu_topic, 2000, &LoggerNodelet::onImu, this);
     frame_sub_ = nh.subscribe(frame_topic, 20, &LoggerNodelet::onFrame, this);
@@ -75,33 +70,76 @@ class LoggerNodelet : public GuardedNodelet {
     window_sub_ = nh.subscribe(estimator_ns + "/window", 2, &LoggerNodelet::onWindow, this);
     points_sub_ = nh.subscribe(estimator_ns + "/points", 2, &LoggerNodelet::onPoints, this);
     lines_sub_ = nh.subscribe(estimator_ns + "/lines", 2, &LoggerNodelet::onLines, this);
+  }
+
+  // Into files no earlier log has (alvio.rawlog, else alvio_1.rawlog ...): a robot's earlier
+  // run, this nodelet before a reload, or the run before a clock jump may have logged here.
+  void openLog(const std::string& first_line) {
+    logger_ = std::make_unique<alvio::MrptLogger>(alvio::freshLogNames(options_, output_dir_),
+                                                  camera_, output_dir_);
+    logger_->log(alvio::LogLevel::kInfo, first_line);
+    alvio::MrptLogger* logger = logger_.get();
+    log_route_.setListener([logger](alvio::LogLevel level, const std::string& message) {
+      logger->log(level, message);
+    });
     const alvio::LoggerPaths& p = logger_->paths();
-    NODELET_INFO("logging into %s (rawlog %s, scene %s, text %s)", output_dir.c_str(),
+    NODELET_INFO("logging into %s (rawlog %s, scene %s, text %s)", output_dir_.c_str(),
                  p.rawlog.empty() ? "off" : p.rawlog.c_str(),
                  p.scene.empty() ? "off" : p.scene.c_str(),
                  p.text.empty() ? "off" : p.text.c_str());
   }
 
-  // A robot's earlier run, or this nodelet before a reload, may have logged into the same
-  // folder: never overwrite it, number the new files instead (alvio_1.rawlog, alvio_1.log).
-  static alvio::LoggerOptions freshNames(alvio::LoggerOptions options, const std::string& dir) {
-    const std::string name = options.name, text = options.text_file;
-    const auto stem = std::filesystem::path(text).stem().string();
-    const auto ext = std::filesystem::path(text).extension().string();
-    for (int n = 1;; ++n) {
-      const std::filesystem::path d(options.out_dir.empty() ? dir : options.out_dir);
-      if (!std::filesystem::exists(d / (options.name + ".rawlog")) &&
-          !std::filesystem::exists(d / (options.name + ".3Dscene")) &&
-          !std::filesystem::exists(d / options.text_file))
-        return options;
-      options.name = name + "_" + std::to_string(n);
-      options.text_file = stem + "_" + std::to_string(n) + ext;
-    }
+  void closeLog(const std::string& why) {
+    log_route_.clearListener();  // waits for a core message being written
+    if (!logger_) return;
+    logger_->flushStats();
+    logger_->log(alvio::LogLevel::kInfo, why + ": " + std::to_string(frames_) + " frames, " +
+                                             std::to_string(poses_) + " poses");
+    const alvio::MapSnapshot map = snapshot();
+    logger_->finish(&map);
+    logger_.reset();
   }
 
-  void onImu(const sensor_msgs::ImuConstPtr& msg) { logger_->addImu(fromMsg(*msg)); }
+  // The clock going back (a bag played again, a clock reset) starts a new run in the estimator
+  // and the map; the log follows into new files, so that no rawlog mixes two clocks and no
+  // scene two world frames. The IMU decides, as in the estimator: it comes straight from the
+  // sensor, while frames and poses lag behind the tracker and the estimator.
+  void startNewLogIfClockJumpedBack(int64_t t_ns) {
+    if (alvio::clockJumpedBack(t_ns, newest_imu_ns_)) {
+      char back[32];
+      std::snprintf(back, sizeof(back), "%.2f s", (newest_imu_ns_ - t_ns) * 1e-9);
+      NODELET_WARN("clock jumped back %s: the log goes on in new files", back);
+      const std::string closed = logger_ ? logger_->paths().rawlog : "";
+      closeLog(std::string("clock jumped back ") + back + ": log closed");
+      window_.reset();
+      points_.reset();
+      lines_.reset();
+      frames_ = poses_ = 0;
+      ++runs_;
+      try {
+        openLog(header_ + "\n  run " + std::to_string(runs_ + 1) + ": the clock jumped back " +
+                back + (closed.empty() ? "" : "; before it: " + closed));
+      } catch (const alvio::Error& e) {  // the folder went away or filled up: stop logging
+        NODELET_ERROR("logging stopped: %s", e.what());
+      }
+      newest_imu_ns_ = t_ns;
+    }
+    newest_imu_ns_ = std::max(newest_imu_ns_, t_ns);
+  }
+
+  // After a clock jump, frames and poses still on the old clock (the tracker's and the
+  // estimator's queues) belong to the closed log: they lie ahead of the new clock by the jump.
+  bool onOldClock(const ros::Time& stamp) const {
+    return runs_ > 0 && alvio::clockJumpedBack(newest_imu_ns_, toNs(stamp));
+  }
+
+  void onImu(const sensor_msgs::ImuConstPtr& msg) {
+    startNewLogIfClockJumpedBack(toNs(msg->header.stamp));
+    if (logger_) logger_->addImu(fromMsg(*msg));
+  }
 
   void onFrame(const SharedTrackedFrame::ConstPtr& frame) {
+    if (!logger_ || onOldClock(frame->features.header.stamp)) return;
     ++frames_;
     if (!frame->image) return;
     try {
@@ -114,6 +152,7 @@ class LoggerNodelet : public GuardedNodelet {
   }
 
   void onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
+    if (!logger_ || onOldClock(msg->header.stamp)) return;
     ++poses_;
     const Eigen::Isometry3d T = fromPose(msg->pose.pose);
     logger_->addPose(
@@ -121,6 +160,7 @@ class LoggerNodelet : public GuardedNodelet {
   }
 
   void onStatus(const alvio::PipelineStatus::ConstPtr& msg) {
+    if (!logger_ || onOldClock(msg->header.stamp)) return;
     alvio::FrameStats stats;
     stats.t = msg->header.stamp.toSec();
     stats.tracked_points = msg->tracked_points;
@@ -131,9 +171,15 @@ class LoggerNodelet : public GuardedNodelet {
     if (logger_->sceneDue(stats.t)) logger_->writeScene(stats.t, snapshot());
   }
 
-  void onWindow(const geometry_msgs::PoseArray::ConstPtr& msg) { window_ = msg; }
-  void onPoints(const sensor_msgs::PointCloud2::ConstPtr& msg) { points_ = msg; }
-  void onLines(const visualization_msgs::MarkerArray::ConstPtr& msg) { lines_ = msg; }
+  void onWindow(const geometry_msgs::PoseArray::ConstPtr& msg) {
+    if (!onOldClock(msg->header.stamp)) window_ = msg;
+  }
+  void onPoints(const sensor_msgs::PointCloud2::ConstPtr& msg) {
+    if (!onOldClock(msg->header.stamp)) points_ = msg;
+  }
+  void onLines(const visualization_msgs::MarkerArray::ConstPtr& msg) {
+    if (msg->markers.empty() || !onOldClock(msg->markers.front().header.stamp)) lines_ = msg;
+  }
 
   // The estimator's window as last published.
   alvio::MapSnapshot snapshot() const {
@@ -152,7 +198,12 @@ class LoggerNodelet : public GuardedNodelet {
   }
 
   CoreLogRoute log_route_;
+  std::string output_dir_, header_;
+  alvio::LoggerOptions options_;
+  alvio::CameraOptions camera_;
   std::unique_ptr<alvio::MrptLogger> logger_;
+  int64_t newest_imu_ns_ = 0;
+  int runs_ = 0;  // clock jumps so far
   geometry_msgs::PoseArray::ConstPtr window_;
   sensor_msgs::PointCloud2::ConstPtr points_;
   visualization_msgs::MarkerArray::ConstPtr lines_;

@@ -33,6 +33,7 @@
 #include "alvio/config/yaml_reader.h"
 #include "alvio/io/euroc_dataset.h"
 #include "alvio/io/trajectory_io.h"
+#include "alvio/logging/fresh_log_names.h"
 #include "alvio/logging/mrpt_logger.h"
 #include "alvio/logging/run_logger.h"
 #include "alvio/pipeline/offline_runner.h"
@@ -227,6 +228,50 @@ TEST(LoggerOptions, LoadsFromYamlWithDefaultsAndNamesBadKeys) {
   const Config c = Config::load(test::sourcePath("config/euroc.yaml"));
   EXPECT_TRUE(c.logger.enabled);
   EXPECT_EQ(c.logger.image_decimation, LoggerOptions().image_decimation);
+}
+
+// ---------------------------------------------------------------------------
+TEST(FreshLogNames, NumberTheNewFilesAndLeaveEarlierLogsAlone) {
+  const std::string dir = test::scratchDir() + "/logs";
+  fs::create_directories(dir);
+  LoggerOptions o;
+  o.scenes = false;
+  o.text_log = false;                              // the rawlog alone marks a log
+  EXPECT_EQ(freshLogNames(o, dir).name, "alvio");  // an empty folder: the plain names
+
+  // Each earlier log (whole, or its rawlog still being written) takes its names.
+  std::string names;
+  for (int run = 0; run < 3; ++run) {
+    const LoggerOptions fresh = freshLogNames(o, dir);
+    names += fresh.name + "; ";
+    MrptLogger logger(fresh, smallCamera(), dir);
+    ImuSample s;
+    s.t_ns = 1'000'000'000LL * (run + 1);
+    logger.addImu(s);
+    if (run < 2) {
+      logger.finish();
+    } else {  // still open: alvio_2.rawlog.part
+      EXPECT_EQ(freshLogNames(o, dir).name, "alvio_3");
+    }
+  }
+  EXPECT_EQ(names, "alvio; alvio_1; alvio_2; ");
+  EXPECT_TRUE(fs::exists(fs::path(dir) / "alvio.rawlog"));
+  EXPECT_TRUE(fs::exists(fs::path(dir) / "alvio_1.rawlog"));
+
+  // A text log alone (the rawlog off) counts as well; a text file in a subfolder keeps it.
+  const std::string other = test::scratchDir() + "/text_only";
+  o.text_log = true;
+  o.text_file = "logs/run.txt";
+  fs::create_directories(fs::path(other) / "logs");
+  std::ofstream(fs::path(other) / "logs/run.txt") << "earlier\n";
+  const LoggerOptions fresh = freshLogNames(o, other);
+  EXPECT_EQ(fresh.name, "alvio_1");
+  EXPECT_EQ(fresh.text_file, "logs/run_1.txt");
+  // options.out_dir, when set, is the folder looked in.
+  o.out_dir = other;
+  EXPECT_EQ(freshLogNames(o, dir).name, "alvio_1");
+  o.out_dir.clear();
+  EXPECT_EQ(freshLogNames(o, dir).name, "alvio_3");
 }
 
 // ---------------------------------------------------------------------------
