@@ -283,6 +283,16 @@ TEST(NodeletPipeline, NodeletsUnloadWritingTheirFilesAndReload) {
   EXPECT_TRUE(waitFor([&] { return fatalLogged("bad_mapping", "publish_period"); }, 5));
   EXPECT_TRUE(waitFor([&] { return fatalLogged("bad_tracker", "points/max_featurez"); }, 5));
 
+  // An empty output_dir (what the launch files pass when none is given) is no folder: the
+  // logger logs into the configuration's logger.out_dir.
+  const std::string config_dir = out + "/logger_from_config";
+  nh.setParam(ns + "/config_logger/output_dir", std::string());
+  nh.setParam(ns + "/config_logger/config/logger/out_dir", config_dir);
+  EXPECT_TRUE(load(ns + "/config_logger", "alvio/LoggerNodelet"));
+  EXPECT_TRUE(unload(ns + "/config_logger"));
+  EXPECT_TRUE(std::filesystem::exists(config_dir + "/alvio.log"))
+      << "the logger did not log into logger.out_dir";
+
   // The manager is still there, with exactly the good nodelets.
   const auto names = listNodelets();
   EXPECT_FALSE(names.empty()) << "the manager does not answer";
