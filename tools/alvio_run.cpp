@@ -56,6 +56,10 @@ int main(int argc, char** argv) {
   args.option("config", "YAML configuration", Config::defaultPath());
   args.option("out", "output folder", "", true);
   args.option("max-frames", "stop after this many images", "-1");
+  args.option("start",
+              "skip this many seconds of data (IMU and images) from the first message: start "
+              "mid-way, as a VIO started while the robot moves",
+              "0");
   args.flag("no-lines", "points only (no line front end, no line landmarks)");
   args.option("line-tracker", "flow (ALVIO optical flow) | descriptor (PL-VIO LBD baseline)");
   args.flag("quiet", "no progress bar");
@@ -115,6 +119,7 @@ int main(int argc, char** argv) {
     RunOptions options;
     options.out_dir = args.get("out");
     options.max_frames = args.getInt("max-frames");
+    options.start_s = args.getDouble("start");
     options.progress = !args.isSet("quiet");
     options.stop = &installStopSignalHandlers();
     std::unique_ptr<RunLogger> logger;

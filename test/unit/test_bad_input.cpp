@@ -221,6 +221,25 @@ TEST(BadDataset, TruncatedPngIsSkippedAndCounted) {
   EXPECT_EQ(summary["frames"], 3);
 }
 
+// --- starting mid-way ---------------------------------------------------------------------
+
+TEST(RunStart, SkipsTheDataBeforeTheStartAndRefusesANegativeOne) {
+  const std::string dir = test::scratchDir();
+  // Images every 50 ms from t0; the IMU from t0 - 0.1 s, so the start counts from there.
+  const std::string data = makeEurocFolder(dir + "/data", 10, 752, 480);
+  RunOptions o = quietRun(dir + "/out");
+  o.start_s = 0.32;  // up to t0 + 0.22 s: the images at t0 + 0.25 .. 0.45 s stay
+  EurocSource source(data);
+  const RunResult r = runOffline(source, defaultConfig(), o);
+  EXPECT_EQ(r.frames, 5u);
+  EXPECT_EQ(r.skipped_images, 0u);  // skipped before the start is not "skipped" (unreadable)
+
+  o.start_s = -1;
+  EurocSource again(data);
+  const std::string msg = errorOf([&] { runOffline(again, defaultConfig(), o); });
+  EXPECT_MENTIONS(msg, "start must be >= 0 s");
+}
+
 // --- starting still ----------------------------------------------------------------------
 
 // The real V1_01 start: the MAV sits on the floor for the 4.7 s of frames (with real IMU

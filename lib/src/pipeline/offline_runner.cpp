@@ -98,9 +98,14 @@ RunResult runOffline(SensorSource& source, const Config& config, const RunOption
   // The newest state as estimated when its frame arrived: whether the IMU biases settle.
   std::ostringstream states;
   states << "t,vx,vy,vz,bax,bay,baz,bgx,bgy,bgz\n";
-  const std::size_t total = options.max_frames > 0
-                                ? std::min<std::size_t>(options.max_frames, source.imageCount())
-                                : source.imageCount();
+  if (!(options.start_s >= 0))
+    throw Error("start must be >= 0 s, got " + std::to_string(options.start_s));
+  // The images left after the start, as the camera's rate counts them (for the progress bar).
+  const std::size_t skipped_estimate = std::min<std::size_t>(
+      source.imageCount(), static_cast<std::size_t>(options.start_s * config.camera.rate_hz));
+  const std::size_t after_start = source.imageCount() - skipped_estimate;
+  const std::size_t total =
+      options.max_frames > 0 ? std::min<std::size_t>(options.max_frames, after_start) : after_start;
   ProgressBar progress("alvio run", total, options.progress);
 
   // Each observer's time goes to its stage; IMU-time work waits for the next frame's row.
@@ -123,6 +128,8 @@ RunResult runOffline(SensorSource& source, const Config& config, const RunOption
   // An image waits until an IMU sample after it has arrived, so the estimator can
   // interpolate the IMU at the image time.
   std::deque<SensorMessage> pending;
+  // The first message's time and the first one kept after options.start_s (0: from the start).
+  int64_t first_ns = -1, start_ns = 0;
   auto processImage = [&](const SensorMessage& m) {
     const cv::Mat image = m.load_image();
     if (image.empty()) {
@@ -151,7 +158,7 @@ RunResult runOffline(SensorSource& source, const Config& config, const RunOption
       if (e.kind == EstimatorEvent::Kind::kInitialized && gt && !result.initialization) {
         InitializationQuality q = initializationQuality(e.window, *gt);
         q.time = e.t;
-        q.since_motion_s = e.t - firstMotion(*gt);
+        q.since_motion_s = e.t - std::max(firstMotion(*gt), nsToSec(start_ns));
         result.initialization = q;
       }
     }
@@ -190,7 +197,14 @@ RunResult runOffline(SensorSource& source, const Config& config, const RunOption
   const auto stopRequested = [&] { return options.stop && options.stop->load(); };
   SensorMessage m;
   std::size_t images_seen = 0, images_of_old_clock = 0;
+  bool started = options.start_s <= 0;
   while (!stopRequested() && source.next(&m)) {
+    if (!started) {
+      if (first_ns < 0) first_ns = m.t_ns;
+      if (m.t_ns < first_ns + secToNs(options.start_s)) continue;
+      started = true;
+      start_ns = m.t_ns;
+    }
     if (m.kind == SensorMessage::Kind::kImu) {
       if (pipeline.addImu(m.imu)) {
         // Images of the old clock still waiting for IMU: none will come after them.

@@ -30,6 +30,9 @@ struct RunOptions {
   std::string out_dir;
   bool progress = true;
   int max_frames = -1;  ///< stop after this many images (-1: all)
+  /// Skip the data of this many seconds from the first message on (IMU and images): a run
+  /// that starts mid-way, as a robot's VIO started while it moves.
+  double start_s = 0;
   /// Called with the run's data (not owned; e.g. the MRPT logger). See run_observer.h.
   std::vector<RunObserver*> observers;
   /// When set (e.g. by SIGINT), the run stops after the current frame and still writes
@@ -39,7 +42,7 @@ struct RunOptions {
 
 struct InitializationQuality {
   double time = 0;                ///< when it initialised (s, dataset time)
-  double since_motion_s = -1;     ///< after the first motion in the ground truth
+  double since_motion_s = -1;     ///< after the first motion in the ground truth (or the start)
   double scale_error = -1;        ///< |s - 1| of the window positions vs ground truth
   double gravity_error_deg = -1;  ///< mean roll/pitch error of the window
 };
