@@ -178,8 +178,13 @@ class TrackerNodelet : public GuardedNodelet {
 
   // After an estimator reset the point tracks start afresh, as in the offline pipeline.
   void onStatus(const alvio::PipelineStatus::ConstPtr& status) {
+    // A new run's first frame (after a clock jump) counts as a reset too, but this tracker
+    // started afresh itself when the image clock jumped. A second reset a few frames into the
+    // new run would leave the initialising window's first frames sharing no point with the
+    // rest: the new run then starts differently from one started on the same data.
+    const bool new_run = status->state == alvio::PipelineStatus::RESET && status->frames == 1;
     // Fewer resets than before: the estimator was restarted (reloaded, new run).
-    if (status->reset_count > reset_count_) reset_pending_ = true;
+    if (status->reset_count > reset_count_ && !new_run) reset_pending_ = true;
     reset_count_ = status->reset_count;
   }
 
