@@ -14,8 +14,8 @@
 
 #include <alvio/PipelineStatus.h>
 
+#include <algorithm>
 #include <cstdio>
-#include <filesystem>
 #include <memory>
 #include <sstream>
 

@@ -9,9 +9,9 @@
 
 namespace alvio {
 
-/// `options` with name and text_file numbered so that no <name>.rawlog (or .rawlog.part),
-/// <name>.3Dscene or
-/// text_file exists yet in `dir` (options.out_dir when set); unchanged when none does.
+/// `options` with name and text_file numbered so that none of <name>.rawlog (or .rawlog.part),
+/// <name>.3Dscene and text_file exists yet in `dir` (options.out_dir when set); unchanged when
+/// none does.
 LoggerOptions freshLogNames(LoggerOptions options, const std::string& dir);
 
 }  // namespace alvio
