@@ -68,16 +68,17 @@ const TruthRun& oracleRun() {
 TEST(PointTruthTool, TheOracleFeedsTrueProjectionsWhoseNoiseTheEstimatorFeels) {
   const TruthRun tracked = runPointTruth("");
   const TruthRun& oracle = oracleRun();
-  const TruthRun noisy = runPointTruth("--oracle --oracle-noise-px 1.0");
+  const TruthRun noisy = runPointTruth("--oracle --oracle-noise-px 3.0");
   ASSERT_EQ(tracked.rc, 0) << tracked.output;
   ASSERT_EQ(oracle.rc, 0) << oracle.output;
   ASSERT_EQ(noisy.rc, 0) << noisy.output;
   ASSERT_GT(tracked.ate, 0) << tracked.output;
   ASSERT_GT(oracle.ate, 0) << oracle.output;
-  // Tracked points lie within a pixel of their true projection (0.15 px median), close enough
-  // that on these 8 s they no longer limit the estimate: tracked and true projections score
-  // 0.0058 and 0.0059 m with keyframes every 15 px (0.0103 and 0.0058 m at 10 px). A pixel of
-  // noise on the true projections costs clearly more (0.0130 m).
+  // Tracked points lie within a pixel of their true projection (0.15 px median). On 8 s the ATE
+  // of one run depends on where the initialisation happens to fall: over seven renderings
+  // (seeds 1-7) tracked points score 0.0033-0.0145 m and true projections 0.0025-0.0082 m, while
+  // 1 px of noise on the true projections (0.0046-0.0128 m) beat either on some of them. 3 px of
+  // noise costs more on every one (0.022-0.27 m), so that is what shows the noise is felt.
   EXPECT_LT(tracked.point_error_px, 1.0);
   EXPECT_LT(tracked.ate, 0.05);
   EXPECT_LT(oracle.ate, noisy.ate);
