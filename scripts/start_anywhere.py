@@ -18,6 +18,8 @@ import sys
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
+from bench import fmt  # scripts/bench.py: "–" for a missing figure
+
 
 def log(msg):
     print(f"\033[1m[alvio starts]\033[0m {msg}", file=sys.stderr, flush=True)
@@ -80,10 +82,6 @@ def summarize(rows, diverged_m):
         "median_scale_error": statistics.median(scales) if scales else None,
         "max_scale_error": max(scales) if scales else None,
     }
-
-
-def fmt(x, spec):
-    return "–" if x is None else format(x, spec)
 
 
 def table(rows, summary, diverged_m):
