@@ -132,7 +132,7 @@ class EstimatorNodelet : public GuardedNodelet {
     {
       std::lock_guard<std::mutex> lock(mutex_);
       const alvio::ImuSample sample = fromMsg(*msg);
-      jumpedBack(sample.t_ns);
+      startNewRunIfClockJumpedBack(sample.t_ns);
       const std::size_t before = sync_.counts().droppedImu();
       sync_.addImu(sample);
       dropped = sync_.counts().droppedImu() - before;
@@ -151,7 +151,7 @@ class EstimatorNodelet : public GuardedNodelet {
       std::lock_guard<std::mutex> lock(mutex_);
       const int64_t t_ns = toNs(msg->features.header.stamp);
       if (frames_of_old_clock_) {
-        if (alvio::clockJumpedBack(newest_ns_, t_ns)) {
+        if (imu_clock_.aheadByAJump(t_ns)) {
           // Tracked before the clock jump that restarted the run: not part of the new run.
           NODELET_WARN_THROTTLE(2.0, "frame at %.3f s is from before the clock jump: dropped",
                                 t_ns * 1e-9);
@@ -179,16 +179,13 @@ class EstimatorNodelet : public GuardedNodelet {
   // starts a new run: the queues are emptied now, the estimator restarted by the worker.
   // The IMU decides, as it comes straight from the sensor; frames lag behind the tracker.
   // Called under mutex_.
-  void jumpedBack(int64_t t_ns) {
-    if (alvio::clockJumpedBack(t_ns, newest_ns_)) {
-      NODELET_WARN("IMU clock jumped back %.2f s: the estimator starts a new run",
-                   (newest_ns_ - t_ns) * 1e-9);
+  void startNewRunIfClockJumpedBack(int64_t t_ns) {
+    if (const int64_t jump_ns = imu_clock_.follow(t_ns)) {
+      NODELET_WARN("IMU clock jumped back %.2f s: the estimator starts a new run", jump_ns * 1e-9);
       sync_ = Sync(sync_.options());
       restart_ = true;
       frames_of_old_clock_ = true;
-      newest_ns_ = t_ns;
     }
-    newest_ns_ = std::max(newest_ns_, t_ns);
   }
 
   // The finished run's trajectory is kept as trajectory_run<N>.tum; trajectory.tum and the
@@ -428,7 +425,7 @@ class EstimatorNodelet : public GuardedNodelet {
   Sync sync_;
   bool stop_ = false, restart_ = false;
   bool frames_of_old_clock_ = false;  // after a clock jump, until a frame on the new clock
-  int64_t newest_ns_ = 0;             // newest IMU stamp
+  alvio::ClockWatch imu_clock_;
 
   // The worker's.
   std::thread worker_;

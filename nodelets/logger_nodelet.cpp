@@ -105,9 +105,9 @@ class LoggerNodelet : public GuardedNodelet {
   // scene two world frames. The IMU decides, as in the estimator: it comes straight from the
   // sensor, while frames and poses lag behind the tracker and the estimator.
   void startNewLogIfClockJumpedBack(int64_t t_ns) {
-    if (alvio::clockJumpedBack(t_ns, newest_imu_ns_)) {
+    if (const int64_t jump_ns = imu_clock_.follow(t_ns)) {
       char back[32];
-      std::snprintf(back, sizeof(back), "%.2f s", (newest_imu_ns_ - t_ns) * 1e-9);
+      std::snprintf(back, sizeof(back), "%.2f s", jump_ns * 1e-9);
       NODELET_WARN("clock jumped back %s: the log goes on in new files", back);
       const std::string closed = logger_ ? logger_->paths().rawlog : "";
       closeLog(std::string("clock jumped back ") + back + ": log closed");
@@ -122,15 +122,13 @@ class LoggerNodelet : public GuardedNodelet {
       } catch (const alvio::Error& e) {  // the folder went away or filled up: stop logging
         NODELET_ERROR("logging stopped: %s", e.what());
       }
-      newest_imu_ns_ = t_ns;
     }
-    newest_imu_ns_ = std::max(newest_imu_ns_, t_ns);
   }
 
   // After a clock jump, frames and poses still on the old clock (the tracker's and the
   // estimator's queues) belong to the closed log: they lie ahead of the new clock by the jump.
   bool onOldClock(const ros::Time& stamp) const {
-    return runs_ > 0 && alvio::clockJumpedBack(newest_imu_ns_, toNs(stamp));
+    return runs_ > 0 && imu_clock_.aheadByAJump(toNs(stamp));
   }
 
   void onImu(const sensor_msgs::ImuConstPtr& msg) {
@@ -202,7 +200,7 @@ class LoggerNodelet : public GuardedNodelet {
   alvio::LoggerOptions options_;
   alvio::CameraOptions camera_;
   std::unique_ptr<alvio::MrptLogger> logger_;
-  int64_t newest_imu_ns_ = 0;
+  alvio::ClockWatch imu_clock_;
   int runs_ = 0;  // clock jumps so far
   geometry_msgs::PoseArray::ConstPtr window_;
   sensor_msgs::PointCloud2::ConstPtr points_;

@@ -65,7 +65,7 @@ class MappingNodelet : public GuardedNodelet {
     std::lock_guard<std::mutex> lock(mutex_);
     // Keyframes leave the estimator's window well after their frame's odometry, so only the
     // odometry tells a clock jump; a keyframe far ahead of it is the old run's.
-    if (alvio::clockJumpedBack(newest_ns_, toNs(msg->header.stamp))) return;
+    if (odometry_clock_.aheadByAJump(toNs(msg->header.stamp))) return;
     map_->addKeyframe(fromMsg(*msg));
     changed_since_publish_ = changed_since_save_ = true;
   }
@@ -84,17 +84,13 @@ class MappingNodelet : public GuardedNodelet {
   // nothing. Like the estimator's trajectory (trajectory_run<N>.tum), the finished run's map is
   // kept, in run<N>/. Called under mutex_.
   void startNewRunIfTimeJumpedBack(const ros::Time& stamp) {
-    const int64_t t_ns = toNs(stamp);
-    if (alvio::clockJumpedBack(t_ns, newest_ns_)) {
-      NODELET_WARN("clock jumped back %.2f s: the map starts afresh (new run)",
-                   (newest_ns_ - t_ns) * 1e-9);
+    if (const int64_t jump_ns = odometry_clock_.follow(toNs(stamp))) {
+      NODELET_WARN("clock jumped back %.2f s: the map starts afresh (new run)", jump_ns * 1e-9);
       ++finished_runs_;
       if (!output_dir_.empty()) save(output_dir_ + "/run" + std::to_string(finished_runs_));
       map_ = std::make_unique<alvio::MapBuilder>(options_);
-      newest_ns_ = t_ns;
       changed_since_publish_ = changed_since_save_ = true;
     }
-    newest_ns_ = std::max(newest_ns_, t_ns);
   }
 
   // Throttled, latched: a display that connects later still gets the last map.
@@ -147,7 +143,7 @@ class MappingNodelet : public GuardedNodelet {
   std::mutex mutex_;  // the timer, callbacks and service share one queue; the destructor not
   alvio::MappingOptions options_;
   std::unique_ptr<alvio::MapBuilder> map_;
-  int64_t newest_ns_ = 0;  // newest odometry stamp
+  alvio::ClockWatch odometry_clock_;
   int finished_runs_ = 0;
   std::string output_dir_, world_frame_, last_error_;
   bool save_on_shutdown_ = true, changed_since_publish_ = false, changed_since_save_ = false;

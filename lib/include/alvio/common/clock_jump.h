@@ -2,6 +2,7 @@
 // A stamp far behind the newest one means the source's clock jumped back (a clock reset, a
 // bag played again), not a late message: what came before cannot be continued from it.
 
+#include <algorithm>
 #include <cstdint>
 
 namespace alvio {
@@ -20,5 +21,30 @@ inline bool clockJumpedBack(int64_t t_ns, int64_t newest_ns) {
 inline bool staleStamp(int64_t t_ns, int64_t newest_ns) {
   return newest_ns != 0 && t_ns <= newest_ns;
 }
+
+/// Follows one source's newest stamp (the IMU, the odometry) and tells when its clock jumps back:
+/// the nodelets start a new run on it.
+class ClockWatch {
+ public:
+  /// Takes the next stamp. Returns how far the clock jumped back (ns) when it did, else 0. After
+  /// a jump the stamp is the newest one: the new clock is followed from there.
+  int64_t follow(int64_t t_ns) {
+    const int64_t back = clockJumpedBack(t_ns, newest_ns_) ? newest_ns_ - t_ns : 0;
+    newest_ns_ = back ? t_ns : std::max(newest_ns_, t_ns);
+    return back;
+  }
+
+  /// True when `t_ns` lies more than a jump ahead of the newest stamp: a message stamped on the
+  /// clock before the last jump, still on its way through a queue. False before any stamp.
+  bool aheadByAJump(int64_t t_ns) const {
+    return newest_ns_ != 0 && clockJumpedBack(newest_ns_, t_ns);
+  }
+
+  /// The newest stamp since the last jump (0: none yet).
+  int64_t newest() const { return newest_ns_; }
+
+ private:
+  int64_t newest_ns_ = 0;
+};
 
 }  // namespace alvio
