@@ -81,14 +81,13 @@ class TrackerNodelet : public GuardedNodelet {
 
   void onImu(const sensor_msgs::ImuConstPtr& msg) {
     const alvio::ImuSample sample = fromMsg(*msg);
-    if (alvio::clockJumpedBack(sample.t_ns, newest_imu_ns_)) {
+    if (const int64_t jump_ns = imu_clock_.follow(sample.t_ns)) {
       // A new run (a bag played again): images of the old clock still waiting are not part of it.
       NODELET_WARN("IMU clock jumped back %.2f s: images waiting for the IMU are dropped",
-                   (newest_imu_ns_ - sample.t_ns) * 1e-9);
+                   jump_ns * 1e-9);
       sync_ = Sync(sync_.options());
-      newest_imu_ns_ = sample.t_ns;
+      images_of_old_clock_ = true;
     }
-    newest_imu_ns_ = std::max(newest_imu_ns_, sample.t_ns);
     sync_.addImu(sample);
     release();
   }
@@ -127,8 +126,20 @@ class TrackerNodelet : public GuardedNodelet {
       track(pending, {});
       return;
     }
+    const int64_t t_ns = toNs(image->header.stamp);
+    if (images_of_old_clock_) {
+      // Images lag the IMU: the old clock's last ones can come after the jump. One left in the
+      // queue would hold back every image of the new clock until it caught up (a whole play of a
+      // bag played again).
+      if (imu_clock_.aheadByAJump(t_ns)) {
+        NODELET_WARN_THROTTLE(2.0, "image at %.3f s is from before the clock jump: dropped",
+                              t_ns * 1e-9);
+        return;
+      }
+      images_of_old_clock_ = false;
+    }
     const std::size_t overflow_before = sync_.counts().frames_overflow;
-    if (!sync_.addFrame(toNs(image->header.stamp), std::move(pending)))
+    if (!sync_.addFrame(t_ns, std::move(pending)))
       NODELET_WARN_THROTTLE(5.0, "image at %.3f s is not after the previous one: skipped",
                             image->header.stamp.toSec());
     if (sync_.counts().frames_overflow != overflow_before)
@@ -197,7 +208,9 @@ class TrackerNodelet : public GuardedNodelet {
   ros::Publisher frame_pub_;
   bool uses_gyro_ = false;
   Sync sync_;
-  int64_t frame_period_ns_ = 50000000, last_t_ns_ = 0, newest_imu_ns_ = 0;
+  int64_t frame_period_ns_ = 50000000, last_t_ns_ = 0;
+  alvio::ClockWatch imu_clock_;
+  bool images_of_old_clock_ = false;  // after an IMU clock jump, until an image on the new clock
   int reset_count_ = 0;
   bool reset_pending_ = false;
 };
