@@ -150,14 +150,11 @@ class EstimatorNodelet : public GuardedNodelet {
     {
       std::lock_guard<std::mutex> lock(mutex_);
       const int64_t t_ns = toNs(msg->features.header.stamp);
-      if (frames_of_old_clock_) {
-        if (imu_clock_.aheadByAJump(t_ns)) {
-          // Tracked before the clock jump that restarted the run: not part of the new run.
-          NODELET_WARN_THROTTLE(2.0, "frame at %.3f s is from before the clock jump: dropped",
-                                t_ns * 1e-9);
-          return;
-        }
-        frames_of_old_clock_ = false;
+      if (imu_clock_.laggingOnOldClock(t_ns)) {
+        // Tracked before the clock jump that restarted the run: not part of the new run.
+        NODELET_WARN_THROTTLE(2.0, "frame at %.3f s is from before the clock jump: dropped",
+                              t_ns * 1e-9);
+        return;
       }
       const auto before = sync_.counts();
       sync_.addFrame(t_ns, msg);
@@ -184,7 +181,6 @@ class EstimatorNodelet : public GuardedNodelet {
       NODELET_WARN("IMU clock jumped back %.2f s: the estimator starts a new run", jump_ns * 1e-9);
       sync_ = Sync(sync_.options());
       restart_ = true;
-      frames_of_old_clock_ = true;
     }
   }
 
@@ -424,7 +420,6 @@ class EstimatorNodelet : public GuardedNodelet {
   std::condition_variable wake_;
   Sync sync_;
   bool stop_ = false, restart_ = false;
-  bool frames_of_old_clock_ = false;  // after a clock jump, until a frame on the new clock
   alvio::ClockWatch imu_clock_;
 
   // The worker's.

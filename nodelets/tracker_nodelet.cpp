@@ -86,7 +86,6 @@ class TrackerNodelet : public GuardedNodelet {
       NODELET_WARN("IMU clock jumped back %.2f s: images waiting for the IMU are dropped",
                    jump_ns * 1e-9);
       sync_ = Sync(sync_.options());
-      images_of_old_clock_ = true;
     }
     sync_.addImu(sample);
     release();
@@ -127,16 +126,11 @@ class TrackerNodelet : public GuardedNodelet {
       return;
     }
     const int64_t t_ns = toNs(image->header.stamp);
-    if (images_of_old_clock_) {
-      // Images lag the IMU: the old clock's last ones can come after the jump. One left in the
-      // queue would hold back every image of the new clock until it caught up (a whole play of a
-      // bag played again).
-      if (imu_clock_.aheadByAJump(t_ns)) {
-        NODELET_WARN_THROTTLE(2.0, "image at %.3f s is from before the clock jump: dropped",
-                              t_ns * 1e-9);
-        return;
-      }
-      images_of_old_clock_ = false;
+    // Images lag the IMU: the old clock's last ones can come after its jump.
+    if (imu_clock_.laggingOnOldClock(t_ns)) {
+      NODELET_WARN_THROTTLE(2.0, "image at %.3f s is from before the clock jump: dropped",
+                            t_ns * 1e-9);
+      return;
     }
     const std::size_t overflow_before = sync_.counts().frames_overflow;
     if (!sync_.addFrame(t_ns, std::move(pending)))
@@ -210,7 +204,6 @@ class TrackerNodelet : public GuardedNodelet {
   Sync sync_;
   int64_t frame_period_ns_ = 50000000, last_t_ns_ = 0;
   alvio::ClockWatch imu_clock_;
-  bool images_of_old_clock_ = false;  // after an IMU clock jump, until an image on the new clock
   int reset_count_ = 0;
   bool reset_pending_ = false;
 };

@@ -36,4 +36,19 @@ TEST(ClockWatch, MessagesFromBeforeTheJumpLieAheadOfTheNewClock) {
   EXPECT_FALSE(clock.aheadByAJump(900 * kMs)) << "behind the newest stamp is not ahead";
 }
 
+TEST(ClockWatch, ALaggingStreamIsDroppedUntilItsFirstMessageOnTheNewClock) {
+  alvio::ClockWatch imu;
+  imu.follow(16'000 * kMs);
+  EXPECT_FALSE(imu.laggingOnOldClock(15'950 * kMs)) << "no jump yet: an image behind the IMU";
+  EXPECT_FALSE(imu.laggingOnOldClock(16'500 * kMs)) << "no jump yet: an image ahead of the IMU";
+  imu.follow(8'000 * kMs);  // the bag played again
+  EXPECT_TRUE(imu.laggingOnOldClock(16'000 * kMs)) << "the old clock's last image";
+  EXPECT_FALSE(imu.laggingOnOldClock(8'000 * kMs)) << "the new clock's first";
+  // Caught up: a message far ahead of the IMU now is an IMU gap, not the old clock (the images
+  // wait for the IMU as usual).
+  EXPECT_FALSE(imu.laggingOnOldClock(8'500 * kMs));
+  imu.follow(1'000 * kMs);  // and again
+  EXPECT_TRUE(imu.laggingOnOldClock(8'500 * kMs));
+}
+
 }  // namespace

@@ -31,7 +31,18 @@ class ClockWatch {
   int64_t follow(int64_t t_ns) {
     const int64_t back = clockJumpedBack(t_ns, newest_ns_) ? newest_ns_ - t_ns : 0;
     newest_ns_ = back ? t_ns : std::max(newest_ns_, t_ns);
+    if (back) lagging_on_old_clock_ = true;
     return back;
+  }
+
+  /// For one stream that lags this source (images and tracked frames behind the IMU): true for
+  /// its messages still stamped on the clock before the last jump, which must be dropped. Left
+  /// waiting for the new clock's IMU, one would hold back every later message until the new
+  /// clock caught up with it. The stream's first message on the new clock ends this.
+  bool laggingOnOldClock(int64_t t_ns) {
+    if (lagging_on_old_clock_ && aheadByAJump(t_ns)) return true;
+    lagging_on_old_clock_ = false;
+    return false;
   }
 
   /// True when `t_ns` lies more than a jump ahead of the newest stamp: a message stamped on the
@@ -45,6 +56,7 @@ class ClockWatch {
 
  private:
   int64_t newest_ns_ = 0;
+  bool lagging_on_old_clock_ = false;  // since the last jump, until the lagging stream caught up
 };
 
 }  // namespace alvio
