@@ -423,15 +423,21 @@ def compare_table(results, a, b, per_run=None, side_by_side=False):
     seeds = sorted({r.get("seed", 1) for r in per_run or []})
     each = len(seeds) > 1
     lines = [f"| sequence | ATE {a} | ATE {b} | ATE ratio |"
-             + (" ATE ratio per run (seeds " + ", ".join(map(str, seeds)) + ") |" if each else "")
+             + (" ATE ratio per run (seeds " + ", ".join(map(str, seeds)) + ") |"
+                " per-run ratio: geometric mean (95 %); runs lower |" if each else "")
              + " total median ratio | opt+marg ratio | peak RSS ratio |",
-             "|---|---|---|---|" + ("---|" if each else "") + "---|---|---|"]
+             "|---|---|---|---|" + ("---|---|" if each else "") + "---|---|---|"]
     by = {(r["sequence"], r["variant"]): r for r in results}
     for seq in dict.fromkeys(r["sequence"] for r in results):
         ra, rb = by.get((seq, a), {}), by.get((seq, b), {})
         per_seed = ""
         if each:
-            per_seed = " / ".join(fmt(x, ".3f") for x in paired_ratios(per_run, seq, a, b)) + " | "
+            ratios = paired_ratios(per_run, seq, a, b)
+            pooled = pooled_ratio(ratios)
+            pooled_cell = "–" if pooled is None else (
+                f"{pooled[0]:.3f} ({pooled[1]:.3f}–{pooled[2]:.3f}); "
+                f"{sum(x is not None and x < 1 for x in ratios)} of {pooled[3]}")
+            per_seed = " / ".join(fmt(x, ".3f") for x in ratios) + f" | {pooled_cell} | "
         lines.append(
             f"| {seq} | {ate_cell(ra)} | {ate_cell(rb)} "
             f"| {fmt(ratio(ra.get('ate'), rb.get('ate')), '.3f')} | {per_seed}"

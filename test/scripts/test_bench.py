@@ -232,6 +232,14 @@ class TablesTest(unittest.TestCase):
         self.assertIn(f"All 6 paired runs: ATE ratio b/a {math.exp(mean):.3f} (geometric mean; "
                       f"95 % interval {math.exp(mean - half):.3f}–{math.exp(mean + half):.3f}); "
                       "3 of 6 runs lower with b.", text)
+        # Each sequence's own runs pooled the same way, in its row.
+        rows = {row[0]: row for row in table_rows(text)}
+        s1 = [math.log(r) for r in ratios["s1"]]
+        m1 = sum(s1) / 3
+        half1 = 4.303 * math.sqrt(sum((x - m1) ** 2 for x in s1) / 2) / math.sqrt(3)  # t, 2 dof
+        self.assertEqual(rows["s1"][5], f"{math.exp(m1):.3f} ({math.exp(m1 - half1):.3f}–"
+                                        f"{math.exp(m1 + half1):.3f}); 1 of 3")
+        self.assertTrue(rows["s2"][5].endswith("; 2 of 3"), rows["s2"][5])
         # Identical runs: ratio 1 with no spread.
         same = [r | {"ate": 0.1} for r in per_run]
         self.assertIn("ATE ratio b/a 1.000 (geometric mean; 95 % interval 1.000–1.000); 0 of 6",
