@@ -25,7 +25,6 @@
 #include <mutex>
 #include <thread>
 
-#include "alvio/common/clock_jump.h"
 #include "alvio/common/error.h"
 #include "alvio/estimator/estimator.h"
 #include "alvio/io/trajectory_io.h"
@@ -128,14 +127,24 @@ class EstimatorNodelet : public GuardedNodelet {
 
   // Callbacks only queue, so they never wait for the estimator.
   void onImu(const sensor_msgs::ImuConstPtr& msg) {
-    std::size_t dropped = 0;
+    bool dropped = false;
     {
       std::lock_guard<std::mutex> lock(mutex_);
-      const alvio::ImuSample sample = fromMsg(*msg);
-      startNewRunIfClockJumpedBack(sample.t_ns);
-      const std::size_t before = sync_.counts().droppedImu();
-      sync_.addImu(sample);
-      dropped = sync_.counts().droppedImu() - before;
+      const std::size_t overflow_before = sync_.counts().imu_overflow;
+      switch (sync_.addImu(fromMsg(*msg))) {
+        case alvio::ImuAdded::kQueued:
+          dropped = sync_.counts().imu_overflow != overflow_before;
+          break;
+        case alvio::ImuAdded::kLate:
+          dropped = true;
+          break;
+        case alvio::ImuAdded::kNewRun:
+          // The worker restarts the estimator; the frames queued from the old clock are gone.
+          NODELET_WARN("IMU clock jumped back %.2f s: the estimator starts a new run",
+                       sync_.lastClockJumpNs() * 1e-9);
+          restart_ = true;
+          break;
+      }
     }
     if (dropped)
       NODELET_WARN_THROTTLE(2.0,
@@ -146,42 +155,34 @@ class EstimatorNodelet : public GuardedNodelet {
   }
 
   void onFrame(const SharedTrackedFrame::ConstPtr& msg) {
-    std::size_t late = 0, overflow = 0;
+    alvio::FrameAdded added;
+    bool overflow = false;
     {
       std::lock_guard<std::mutex> lock(mutex_);
       const int64_t t_ns = toNs(msg->features.header.stamp);
-      if (imu_clock_.laggingOnOldClock(t_ns)) {
-        // Tracked before the clock jump that restarted the run: not part of the new run.
-        NODELET_WARN_THROTTLE(2.0, "frame at %.3f s is from before the clock jump: dropped",
-                              t_ns * 1e-9);
-        return;
-      }
-      const auto before = sync_.counts();
-      sync_.addFrame(t_ns, msg);
-      late = sync_.counts().frames_late - before.frames_late;
-      overflow = sync_.counts().frames_overflow - before.frames_overflow;
+      const std::size_t overflow_before = sync_.counts().frames_overflow;
+      added = sync_.addFrame(t_ns, msg);
+      overflow = sync_.counts().frames_overflow != overflow_before;
     }
-    if (late)
-      NODELET_WARN_THROTTLE(2.0, "frame at %.3f s dropped: not after the previous frame",
-                            msg->features.header.stamp.toSec());
+    const double t = msg->features.header.stamp.toSec();
+    switch (added) {
+      case alvio::FrameAdded::kQueued:
+      case alvio::FrameAdded::kHeld:  // the clock jump is told when the IMU follows
+        break;
+      case alvio::FrameAdded::kLate:
+        NODELET_WARN_THROTTLE(2.0, "frame at %.3f s dropped: not after the previous frame", t);
+        break;
+      case alvio::FrameAdded::kOldClock:
+        // Tracked before the clock jump that restarted the run: not part of the new run.
+        NODELET_WARN_THROTTLE(2.0, "frame at %.3f s is from before the clock jump: dropped", t);
+        break;
+    }
     if (overflow)
       NODELET_WARN_THROTTLE(2.0,
                             "frame queue full (%zu frames): oldest frame dropped (the estimator "
                             "is too slow, or the IMU is behind the camera)",
                             sync_.options().max_frames);
     wake_.notify_one();
-  }
-
-  // The IMU clock going back (a bag played again, a restarted simulation, a clock reset)
-  // starts a new run: the queues are emptied now, the estimator restarted by the worker.
-  // The IMU decides, as it comes straight from the sensor; frames lag behind the tracker.
-  // Called under mutex_.
-  void startNewRunIfClockJumpedBack(int64_t t_ns) {
-    if (const int64_t jump_ns = imu_clock_.follow(t_ns)) {
-      NODELET_WARN("IMU clock jumped back %.2f s: the estimator starts a new run", jump_ns * 1e-9);
-      sync_ = Sync(sync_.options());
-      restart_ = true;
-    }
   }
 
   // The finished run's trajectory is kept as trajectory_run<N>.tum; trajectory.tum and the
@@ -420,7 +421,6 @@ class EstimatorNodelet : public GuardedNodelet {
   std::condition_variable wake_;
   Sync sync_;
   bool stop_ = false, restart_ = false;
-  alvio::ClockWatch imu_clock_;
 
   // The worker's.
   std::thread worker_;

@@ -81,13 +81,10 @@ class TrackerNodelet : public GuardedNodelet {
 
   void onImu(const sensor_msgs::ImuConstPtr& msg) {
     const alvio::ImuSample sample = fromMsg(*msg);
-    if (const int64_t jump_ns = imu_clock_.follow(sample.t_ns)) {
+    if (sync_.addImu(sample) == alvio::ImuAdded::kNewRun)
       // A new run (a bag played again): images of the old clock still waiting are not part of it.
       NODELET_WARN("IMU clock jumped back %.2f s: images waiting for the IMU are dropped",
-                   jump_ns * 1e-9);
-      sync_ = Sync(sync_.options());
-    }
-    sync_.addImu(sample);
+                   sync_.lastClockJumpNs() * 1e-9);
     release();
   }
 
@@ -126,16 +123,25 @@ class TrackerNodelet : public GuardedNodelet {
       return;
     }
     const int64_t t_ns = toNs(image->header.stamp);
-    // Images lag the IMU: the old clock's last ones can come after its jump.
-    if (imu_clock_.laggingOnOldClock(t_ns)) {
-      NODELET_WARN_THROTTLE(2.0, "image at %.3f s is from before the clock jump: dropped",
-                            t_ns * 1e-9);
-      return;
-    }
     const std::size_t overflow_before = sync_.counts().frames_overflow;
-    if (!sync_.addFrame(t_ns, std::move(pending)))
-      NODELET_WARN_THROTTLE(5.0, "image at %.3f s is not after the previous one: skipped",
-                            image->header.stamp.toSec());
+    switch (sync_.addFrame(t_ns, std::move(pending))) {
+      case alvio::FrameAdded::kQueued:
+        break;
+      case alvio::FrameAdded::kHeld:
+        NODELET_WARN_THROTTLE(2.0,
+                              "image clock jumped back to %.3f s before the IMU's on %s: images "
+                              "wait for the IMU's new clock",
+                              t_ns * 1e-9, imu_sub_.getTopic().c_str());
+        break;
+      case alvio::FrameAdded::kLate:
+        NODELET_WARN_THROTTLE(5.0, "image at %.3f s is not after the previous one: skipped",
+                              t_ns * 1e-9);
+        break;
+      case alvio::FrameAdded::kOldClock:
+        NODELET_WARN_THROTTLE(2.0, "image at %.3f s is from before the clock jump: dropped",
+                              t_ns * 1e-9);
+        break;
+    }
     if (sync_.counts().frames_overflow != overflow_before)
       NODELET_WARN_THROTTLE(5.0,
                             "%zu images waited for the IMU on %s (points.gyro_flow, "
@@ -203,7 +209,6 @@ class TrackerNodelet : public GuardedNodelet {
   bool uses_gyro_ = false;
   Sync sync_;
   int64_t frame_period_ns_ = 50000000, last_t_ns_ = 0;
-  alvio::ClockWatch imu_clock_;
   int reset_count_ = 0;
   bool reset_pending_ = false;
 };
