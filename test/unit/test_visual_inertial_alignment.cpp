@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <random>
+
 #include "alvio/config/config.h"
 #include "alvio/estimator/initialization/visual_inertial_alignment.h"
 #include "synthetic_scenario.h"
@@ -77,4 +79,64 @@ TEST(VisualInertialAlignment, RecoversScaleGravityAndGyroBias) {
 // before: the solved bias is still the absolute one, not the correction to it.
 TEST(VisualInertialAlignment, GyroBiasIsAbsoluteWhenLinearisedAtAnotherBias) {
   expectRecovered(Eigen::Vector3d(0.03, -0.02, 0.04));
+}
+
+namespace {
+// 1.5 s at 20 Hz of a body that does not turn, moving along `p_w_b`, its IMU at 200 Hz without
+// noise or bias, and visual positions scaled by 1 / kTrueScale with 2 mm of noise (metric).
+template <typename Path>
+AlignmentInput linearMotion(const Path& p_w_b, const Eigen::Vector3d& t_b_c) {
+  AlignmentInput in;
+  in.R_c0_w = Eigen::Matrix3d::Identity();
+  std::mt19937 rng(7);
+  std::normal_distribution<double> noise(0.0, 0.002);
+  const auto specificForce = [&p_w_b](double t) {
+    const double h = 1e-4;
+    return Eigen::Vector3d((p_w_b(t + h) - 2 * p_w_b(t) + p_w_b(t - h)) / (h * h) +
+                           Eigen::Vector3d(0, 0, 9.81));
+  };
+  for (int f = 0; f <= 30; ++f) {
+    const double t = 0.05 * f;
+    AlignmentFrame a;
+    a.R_c0_b = Eigen::Matrix3d::Identity();
+    const Eigen::Vector3d jitter(noise(rng), noise(rng), noise(rng));
+    a.p_c0_c = (p_w_b(t) + t_b_c + jitter) / kTrueScale;
+    if (f > 0) {
+      const double t0 = t - 0.05;
+      auto pre = std::make_unique<ImuPreintegration>(specificForce(t0), Eigen::Vector3d::Zero(),
+                                                     Eigen::Vector3d::Zero(),
+                                                     Eigen::Vector3d::Zero(), ImuNoise());
+      for (int k = 1; k <= 10; ++k)
+        pre->push(0.005, specificForce(t0 + 0.005 * k), Eigen::Vector3d::Zero());
+      a.imu = pre.get();
+      in.pre.push_back(std::move(pre));
+    }
+    in.frames.push_back(a);
+  }
+  return in;
+}
+}  // namespace
+
+// Started mid-flight at nearly constant velocity, the scale is left to the noise: the alignment
+// must say how uncertain it is, so that the estimator can wait for the motion to change.
+TEST(VisualInertialAlignment, TellsHowWellTheMotionPinsTheScaleDown) {
+  const Eigen::Vector3d t_b_c(0.02, -0.06, 0.01);
+  const auto turning = [](double t) {
+    return Eigen::Vector3d(0.8 * t + 0.3 * std::sin(3 * t), 0.4 * std::cos(3 * t), 0.1 * t);
+  };
+  const auto cruising = [](double t) {
+    return Eigen::Vector3d(0.8 * t + 0.01 * std::sin(3 * t), 0.2 * t, 0.1 * t);
+  };
+  AlignmentInput accelerating = linearMotion(turning, t_b_c);
+  AlignmentInput steady = linearMotion(cruising, t_b_c);
+  AlignmentResult a, s;
+  ASSERT_TRUE(alignVisualInertial(accelerating.frames, t_b_c, 9.81, &a)) << a.failure;
+  EXPECT_NEAR(a.scale, kTrueScale, 0.05 * kTrueScale);
+  EXPECT_GT(a.scale_rel_sigma, 0.0);
+  EXPECT_LT(a.scale_rel_sigma, 0.03);
+  // The steady window aligns, to a scale shrunk by the noise (0.05 here, not 4): only its
+  // uncertainty tells.
+  ASSERT_TRUE(alignVisualInertial(steady.frames, t_b_c, 9.81, &s)) << s.failure;
+  EXPECT_GT(s.scale_rel_sigma, 0.3) << "scale " << s.scale;
+  EXPECT_GT(s.scale_rel_sigma, 10 * a.scale_rel_sigma);
 }

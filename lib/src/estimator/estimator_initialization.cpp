@@ -184,6 +184,15 @@ bool Estimator::alignWithImu(double t) {
     waitFor(&last_wait_reason_, &events_, t, "visual-inertial alignment failed: " + result.failure);
     return false;
   }
+  if (options_.init_max_scale_sigma > 0 &&
+      !(result.scale_rel_sigma <= options_.init_max_scale_sigma)) {
+    // The reason is logged once; each attempt's figure only at debug level.
+    waitFor(&last_wait_reason_, &events_, t,
+            "scale not yet observable: the window moved at nearly constant velocity");
+    logDebug("scale sigma ", 100 * result.scale_rel_sigma, " % > ",
+             100 * options_.init_max_scale_sigma, " %");
+    return false;
+  }
 
   // Keyframe states in the c0 frame, metric, then rotated so gravity points down -z.
   for (int i = 0; i <= frame_count_; ++i) {
@@ -223,8 +232,8 @@ bool Estimator::alignWithImu(double t) {
   std::vector<Eigen::Vector3d> P(Ps_.begin(), Ps_.end());
   std::vector<Eigen::Matrix3d> R(Rs_.begin(), Rs_.end());
   points_.triangulate(P, R, T_b_c_);
-  logInfo("initialised at t=", stampText(t), ": scale ", s, ", gyroscope bias ",
-          result.gyro_bias.transpose());
+  logInfo("initialised at t=", stampText(t), ": scale ", s, " (sigma ",
+          100 * result.scale_rel_sigma, " %), gyroscope bias ", result.gyro_bias.transpose());
   return true;
 }
 

@@ -78,6 +78,9 @@ struct EstimatorOptions {
   double init_accel_bias_sigma = 0.2;  ///< bias prior at initialisation [m/s^2] (<= 0: none)
   double init_gyro_bias_sigma = 0.05;  ///< [rad/s]
   double init_max_accel_bias = 0.5;    ///< reject an initialisation that needs a larger bias
+  /// Wait while the alignment's scale is this uncertain (standard deviation over the scale;
+  /// 0: off). Nearly constant velocity leaves the scale to the noise, as when started mid-flight.
+  double init_max_scale_sigma = 0;
   /// After alignment the window keeps being optimised, without output, until one frame moves
   /// its scale by less than this fraction (a short burst of motion leaves the scale loose)...
   double init_settle_change = 0.003;

@@ -1,7 +1,9 @@
 #include "alvio/estimator/initialization/visual_inertial_alignment.h"
 
 #include <Eigen/Cholesky>
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace alvio {
 namespace {
@@ -35,16 +37,24 @@ Eigen::Matrix<double, 3, 2> tangentBasis(const Eigen::Vector3d& g) {
   return B;
 }
 
+struct LinearSolution {
+  Eigen::VectorXd x;  ///< [v_0..v_n, gravity terms, 100 s]
+  /// Standard deviation of the last unknown (100 s), from the normal equations and the
+  /// residuals' own variance: how well this window's motion pins the scale down.
+  double scale_sigma = 0;
+};
+
 // Builds and solves the linear system over [v_0..v_n (body frames), gravity terms, scale].
 // With `g_fixed` given, gravity is g_fixed + B w (2 unknowns); otherwise it is 3 unknowns.
-Eigen::VectorXd solveLinear(const std::vector<AlignmentFrame>& frames, const Eigen::Vector3d& t_b_c,
-                            const Eigen::Vector3d* g_fixed, const Eigen::Matrix<double, 3, 2>* B) {
+LinearSolution solveLinear(const std::vector<AlignmentFrame>& frames, const Eigen::Vector3d& t_b_c,
+                           const Eigen::Vector3d* g_fixed, const Eigen::Matrix<double, 3, 2>* B) {
   const int n_frames = static_cast<int>(frames.size());
   const int n_g = g_fixed ? 2 : 3;
   const int n = 3 * n_frames + n_g + 1;
   const int extra = n_g + 1;
   Eigen::MatrixXd A = Eigen::MatrixXd::Zero(n, n);
   Eigen::VectorXd b = Eigen::VectorXd::Zero(n);
+  double zz = 0;  // sum of z'z: with x'b it gives the residuals' sum of squares
   for (int k = 1; k < n_frames; ++k) {
     const auto& fi = frames[k - 1];
     const auto& fj = frames[k];
@@ -70,6 +80,7 @@ Eigen::VectorXd solveLinear(const std::vector<AlignmentFrame>& frames, const Eig
     }
     // Scale is estimated as 100 s so the unknowns are of similar magnitude.
     H.block<3, 1>(0, 6 + n_g) = RiT * (fj.p_c0_c - fi.p_c0_c) / 100.0;
+    zz += z.squaredNorm();
     const Eigen::MatrixXd HtH = H.transpose() * H;
     const Eigen::VectorXd Htz = H.transpose() * z;
     const int iv = 3 * (k - 1);
@@ -80,9 +91,20 @@ Eigen::VectorXd solveLinear(const std::vector<AlignmentFrame>& frames, const Eig
     A.block(iv, n - extra, 6, extra) += HtH.topRightCorner(6, extra);
     A.block(n - extra, iv, extra, 6) += HtH.bottomLeftCorner(extra, 6);
   }
-  A *= 1000.0;
-  b *= 1000.0;
-  return A.ldlt().solve(b);
+  constexpr double kConditioning = 1000.0;
+  A *= kConditioning;
+  b *= kConditioning;
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(A);
+  LinearSolution solution;
+  solution.x = ldlt.solve(b);
+  const int rows = 6 * (n_frames - 1);
+  if (rows > n) {
+    const double rss = zz - solution.x.dot(b) / kConditioning;
+    const double variance = std::max(0.0, rss) / (rows - n);
+    const double inverse_ss = kConditioning * ldlt.solve(Eigen::VectorXd::Unit(n, n - 1))[n - 1];
+    solution.scale_sigma = std::sqrt(variance * std::max(0.0, inverse_ss));
+  }
+  return solution;
 }
 
 }  // namespace
@@ -98,7 +120,7 @@ bool alignVisualInertial(std::vector<AlignmentFrame>& frames, const Eigen::Vecto
     frames[k].imu->repropagate(Eigen::Vector3d::Zero(), result->gyro_bias);
 
   const int n_frames = static_cast<int>(frames.size());
-  Eigen::VectorXd x = solveLinear(frames, t_b_c, nullptr, nullptr);
+  Eigen::VectorXd x = solveLinear(frames, t_b_c, nullptr, nullptr).x;
   Eigen::Vector3d g = x.segment<3>(3 * n_frames);
   double scale = x[3 * n_frames + 3] / 100.0;
   if (std::abs(g.norm() - gravity_magnitude) > 1.0 || scale < 0) {
@@ -108,12 +130,17 @@ bool alignVisualInertial(std::vector<AlignmentFrame>& frames, const Eigen::Vecto
   }
   // Refine with the gravity magnitude fixed: iterate on its 2-DoF tangent space.
   Eigen::Vector3d g0 = g.normalized() * gravity_magnitude;
+  LinearSolution refined;
   for (int it = 0; it < 4; ++it) {
     const Eigen::Matrix<double, 3, 2> B = tangentBasis(g0);
-    x = solveLinear(frames, t_b_c, &g0, &B);
+    refined = solveLinear(frames, t_b_c, &g0, &B);
+    x = refined.x;
     g0 = (g0 + B * x.segment<2>(3 * n_frames)).normalized() * gravity_magnitude;
   }
   scale = x[3 * n_frames + 2] / 100.0;
+  const double rel_sigma = refined.scale_sigma / 100.0 / scale;
+  result->scale_rel_sigma =
+      std::isfinite(rel_sigma) ? rel_sigma : std::numeric_limits<double>::infinity();
   if (scale < 0) {
     result->failure = "negative scale after gravity refinement";
     return false;
