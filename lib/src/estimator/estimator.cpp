@@ -81,6 +81,7 @@ void Estimator::clearState() {
   frame_count_ = 0;
   last_init_attempt_ = -1e9;
   first_moving_attempt_ = -1;
+  first_steady_alignment_ = -1;
   last_wait_reason_.clear();
   bias_prior_pending_ = false;
   settling_ = false;

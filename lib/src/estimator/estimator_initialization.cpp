@@ -184,14 +184,22 @@ bool Estimator::alignWithImu(double t) {
     waitFor(&last_wait_reason_, &events_, t, "visual-inertial alignment failed: " + result.failure);
     return false;
   }
-  if (options_.init_max_scale_sigma > 0 &&
-      !(result.scale_rel_sigma <= options_.init_max_scale_sigma)) {
-    // The reason is logged once; each attempt's figure only at debug level.
-    waitFor(&last_wait_reason_, &events_, t,
-            "scale not yet observable: the window moved at nearly constant velocity");
-    logDebug("scale sigma ", 100 * result.scale_rel_sigma, " % > ",
-             100 * options_.init_max_scale_sigma, " %");
-    return false;
+  if (options_.init_min_scale_motion_m > 0 &&
+      !(result.scale_motion_m >= options_.init_min_scale_motion_m)) {
+    if (first_steady_alignment_ < 0) first_steady_alignment_ = t;
+    // Noise in the visual positions shrinks the aligned scale, and the motion seen with it: a
+    // front end that noisy would wait for ever.
+    if (t - first_steady_alignment_ < options_.init_scale_motion_max_wait_s) {
+      // The reason is logged once; each attempt's figure only at debug level.
+      waitFor(&last_wait_reason_, &events_, t,
+              "scale not yet observable: the window moved at nearly constant velocity");
+      logDebug("scale motion ", 1000 * result.scale_motion_m, " mm < ",
+               1000 * options_.init_min_scale_motion_m, " mm");
+      return false;
+    }
+    logWarn("initialising after ", options_.init_scale_motion_max_wait_s, " s on ",
+            1000 * result.scale_motion_m,
+            " mm of motion off constant velocity: the scale may be off until the motion changes");
   }
 
   // Keyframe states in the c0 frame, metric, then rotated so gravity points down -z.
@@ -232,8 +240,9 @@ bool Estimator::alignWithImu(double t) {
   std::vector<Eigen::Vector3d> P(Ps_.begin(), Ps_.end());
   std::vector<Eigen::Matrix3d> R(Rs_.begin(), Rs_.end());
   points_.triangulate(P, R, T_b_c_);
-  logInfo("initialised at t=", stampText(t), ": scale ", s, " (sigma ",
-          100 * result.scale_rel_sigma, " %), gyroscope bias ", result.gyro_bias.transpose());
+  logInfo("initialised at t=", stampText(t), ": scale ", s, " (from ", 1000 * result.scale_motion_m,
+          " mm of motion off constant velocity, residual rms ", result.residual_rms,
+          "), gyroscope bias ", result.gyro_bias.transpose());
   return true;
 }
 

@@ -56,7 +56,10 @@ EstimatorOptions EstimatorOptions::load(const YamlReader& yaml, const std::strin
       yaml.getInt(p + "init_min_correspondences", o.init_min_correspondences);
   o.init_retry_interval_s = yaml.getDouble(p + "init_retry_interval_s", o.init_retry_interval_s);
   o.init_max_accel_bias = yaml.getDouble(p + "init_max_accel_bias", o.init_max_accel_bias);
-  o.init_max_scale_sigma = yaml.getDouble(p + "init_max_scale_sigma", o.init_max_scale_sigma);
+  o.init_min_scale_motion_m =
+      yaml.getDouble(p + "init_min_scale_motion_m", o.init_min_scale_motion_m);
+  o.init_scale_motion_max_wait_s =
+      yaml.getDouble(p + "init_scale_motion_max_wait_s", o.init_scale_motion_max_wait_s);
   o.init_settle_change = yaml.getDouble(p + "init_settle_change", o.init_settle_change);
   o.init_settle_max_s = yaml.getDouble(p + "init_settle_max_s", o.init_settle_max_s);
   o.init_min_excitation = yaml.getDouble(p + "init_min_excitation", o.init_min_excitation);
@@ -72,8 +75,10 @@ EstimatorOptions EstimatorOptions::load(const YamlReader& yaml, const std::strin
   if (o.max_iterations < 1) throw Error(yaml.where(p + "max_iterations") + " must be at least 1");
   if (o.init_max_iterations < 1)
     throw Error(yaml.where(p + "init_max_iterations") + " must be at least 1");
-  if (o.init_max_scale_sigma < 0)
-    throw Error(yaml.where(p + "init_max_scale_sigma") + " must not be negative (0: off)");
+  if (o.init_min_scale_motion_m < 0)
+    throw Error(yaml.where(p + "init_min_scale_motion_m") + " must not be negative (0: off)");
+  if (o.init_scale_motion_max_wait_s < 0)
+    throw Error(yaml.where(p + "init_scale_motion_max_wait_s") + " must not be negative");
   if (o.init_settle_change < 0)
     throw Error(yaml.where(p + "init_settle_change") + " must not be negative");
   if (o.init_settle_max_s < 0)

@@ -250,7 +250,8 @@ class Estimator {
   LogThrottle imu_late_, imu_nonfinite_;  // dropped samples, warned about once per 2 s
 
   double last_init_attempt_ = -1e9;
-  double first_moving_attempt_ = -1;  ///< when the relaxed parallax was first seen
+  double first_moving_attempt_ = -1;    ///< when the relaxed parallax was first seen
+  double first_steady_alignment_ = -1;  ///< when init_min_scale_motion_m first held one back
   std::string last_wait_reason_;
   Eigen::Matrix3d last_R_ = Eigen::Matrix3d::Identity(), back_R0_ = Eigen::Matrix3d::Identity();
   Eigen::Vector3d last_P_ = Eigen::Vector3d::Zero(), back_P0_ = Eigen::Vector3d::Zero();

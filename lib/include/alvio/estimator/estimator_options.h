@@ -78,9 +78,10 @@ struct EstimatorOptions {
   double init_accel_bias_sigma = 0.2;  ///< bias prior at initialisation [m/s^2] (<= 0: none)
   double init_gyro_bias_sigma = 0.05;  ///< [rad/s]
   double init_max_accel_bias = 0.5;    ///< reject an initialisation that needs a larger bias
-  /// Wait while the alignment's scale is this uncertain (standard deviation over the scale;
-  /// 0: off). Nearly constant velocity leaves the scale to the noise, as when started mid-flight.
-  double init_max_scale_sigma = 0;
+  /// Wait until the window's motion departs this far from constant velocity (m; 0: off): the
+  /// alignment reads the scale from that departure (AlignmentResult::scale_motion_m).
+  double init_min_scale_motion_m = 0.005;
+  double init_scale_motion_max_wait_s = 3;  ///< ...for this long at most
   /// After alignment the window keeps being optimised, without output, until one frame moves
   /// its scale by less than this fraction (a short burst of motion leaves the scale loose)...
   double init_settle_change = 0.003;

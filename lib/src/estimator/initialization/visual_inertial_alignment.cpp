@@ -3,7 +3,6 @@
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 namespace alvio {
 namespace {
@@ -39,9 +38,10 @@ Eigen::Matrix<double, 3, 2> tangentBasis(const Eigen::Vector3d& g) {
 
 struct LinearSolution {
   Eigen::VectorXd x;  ///< [v_0..v_n, gravity terms, 100 s]
-  /// Standard deviation of the last unknown (100 s), from the normal equations and the
-  /// residuals' own variance: how well this window's motion pins the scale down.
-  double scale_sigma = 0;
+  /// The last unknown's (100 s) standard deviation for rows of unit noise: how weakly the
+  /// window's motion ties the scale down, whatever the noise.
+  double scale_sigma_per_noise = 0;
+  double residual_rms = 0;  ///< of the rows (m, m/s)
 };
 
 // Builds and solves the linear system over [v_0..v_n (body frames), gravity terms, scale].
@@ -102,7 +102,8 @@ LinearSolution solveLinear(const std::vector<AlignmentFrame>& frames, const Eige
     const double rss = zz - solution.x.dot(b) / kConditioning;
     const double variance = std::max(0.0, rss) / (rows - n);
     const double inverse_ss = kConditioning * ldlt.solve(Eigen::VectorXd::Unit(n, n - 1))[n - 1];
-    solution.scale_sigma = std::sqrt(variance * std::max(0.0, inverse_ss));
+    solution.scale_sigma_per_noise = std::sqrt(std::max(0.0, inverse_ss));
+    solution.residual_rms = std::sqrt(variance);
   }
   return solution;
 }
@@ -138,13 +139,10 @@ bool alignVisualInertial(std::vector<AlignmentFrame>& frames, const Eigen::Vecto
     g0 = (g0 + B * x.segment<2>(3 * n_frames)).normalized() * gravity_magnitude;
   }
   scale = x[3 * n_frames + 2] / 100.0;
-  const double rel_sigma = refined.scale_sigma / 100.0 / scale;
-  result->scale_rel_sigma =
-      std::isfinite(rel_sigma) ? rel_sigma : std::numeric_limits<double>::infinity();
-  if (scale < 0) {
-    result->failure = "negative scale after gravity refinement";
-    return false;
-  }
+  // sigma(s) / s = noise / (100 s / sigma per noise): the quotient is a length.
+  const double motion = 100.0 * scale / refined.scale_sigma_per_noise;
+  result->scale_motion_m = std::isfinite(motion) ? motion : 0.0;
+  result->residual_rms = refined.residual_rms;
   result->gravity_c0 = g0;
   result->scale = scale;
   result->velocities_body.clear();

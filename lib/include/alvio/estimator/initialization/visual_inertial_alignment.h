@@ -22,10 +22,12 @@ struct AlignmentResult {
   Eigen::Vector3d gyro_bias = Eigen::Vector3d::Zero();
   Eigen::Vector3d gravity_c0 = Eigen::Vector3d::Zero();  ///< "up" vector (magnitude g) in c0
   double scale = 0;
-  /// The scale's standard deviation over the scale, from the linear system and the spread of
-  /// its residuals: large when the window moved at nearly constant velocity, which leaves the
-  /// scale to the noise (and shrinks it, as noise in the visual positions does in least squares).
-  double scale_rel_sigma = 0;
+  /// How far the window's motion departs from constant velocity, as the alignment sees it (m):
+  /// the scale is read from that departure alone, so its relative error is about the rows'
+  /// noise over this. A steady turn or cruise mid-flight leaves millimetres, and the least
+  /// squares scale then shrinks towards zero with the noise in the visual positions.
+  double scale_motion_m = 0;
+  double residual_rms = 0;                       ///< of the alignment's rows (m, m/s)
   std::vector<Eigen::Vector3d> velocities_body;  ///< per frame, in its body frame
   std::string failure;                           ///< why it failed, when it did
 };
