@@ -27,6 +27,7 @@ struct RunOutcome {
   std::optional<InitializationQuality> init;
   std::set<std::string> line_schur_structures;  // Ceres's eliminators in solves with lines
   std::vector<OptimizationStats> first_solves;  // of the first two frames solved
+  std::vector<std::string> waits;               // why initialisation waited, as reported
 };
 
 // `blackout` (seconds from start, [begin, end)) removes the features from those frames:
@@ -70,11 +71,13 @@ RunOutcome runEstimator(const test::SyntheticScenario& s, const Config& c,
     if (stats.line_residuals > 0 && !stats.schur_structure.empty())
       out.line_schur_structures.insert(stats.schur_structure);
     for (const auto& l : estimator.takeRetiredLines()) out.retired.push_back(l);
-    for (const auto& e : estimator.takeEvents())
+    for (const auto& e : estimator.takeEvents()) {
+      if (e.kind == EstimatorEvent::Kind::kWaiting) out.waits.push_back(e.message);
       if (e.kind == EstimatorEvent::Kind::kInitialized && !out.init) {
         out.init = initializationQuality(e.window, gt);
         out.init->time = e.t - nsToSec(test::SyntheticScenario::kStartNs);
       }
+    }
   }
   out.resets = estimator.resetCount();
   out.lines = estimator.lineSegments();
@@ -158,6 +161,29 @@ TEST(Estimator, ASolveThatTakesNoStepDoesNotEndTheSettling) {
   const auto [a, s] = runWithoutAndWithSettling(stepless);
   ASSERT_TRUE(a.init && s.init);
   EXPECT_GE(s.init->time, a.init->time + stepless.estimator.init_settle_max_s - 1e-6);
+}
+
+// A window whose motion departs too little from constant velocity is not aligned: the
+// estimator says why and waits, for init_scale_motion_max_wait_s at most. Here no window can
+// pass (100 m), so it initialises exactly when the wait runs out.
+TEST(Estimator, WaitsForMotionOffConstantVelocityForAtMostTheConfiguredTime) {
+  Config c = Config::load(test::sourcePath("config/euroc.yaml"));
+  c.estimator.init_settle_max_s = 0;  // the output starts at the alignment
+  c.estimator.init_min_scale_motion_m = 0;
+  test::ScenarioOptions so;
+  so.duration_s = 8;
+  const test::SyntheticScenario scenario(so, c.camera, c.imu);
+  const RunOutcome free = runEstimator(scenario, c);
+  c.estimator.init_min_scale_motion_m = 100;
+  c.estimator.init_scale_motion_max_wait_s = 1.0;
+  const RunOutcome held = runEstimator(scenario, c);
+  ASSERT_TRUE(free.init && held.init);
+  const auto waited = std::find_if(held.waits.begin(), held.waits.end(), [](const auto& w) {
+    return w.find("scale not yet observable") != std::string::npos;
+  });
+  EXPECT_NE(waited, held.waits.end());
+  EXPECT_GE(held.init->time, free.init->time + 1.0 - 1e-6);
+  EXPECT_LE(held.init->time, free.init->time + 1.0 + c.estimator.init_retry_interval_s + 0.051);
 }
 
 // Losing every feature resets the estimator; it re-initialises and the output
