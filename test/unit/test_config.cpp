@@ -97,6 +97,18 @@ TEST(Config, NegativeSettlingIsRejected) {
                         {"estimator.init_settle_change", "must not be negative"});
 }
 
+TEST(Config, TheWaitForMotionOffConstantVelocityIsReadAndANegativeOneIsRejected) {
+  const Config c = Config::load(test::sourcePath("config/euroc.yaml"));
+  EXPECT_DOUBLE_EQ(c.estimator.init_min_scale_motion_m, 0.005);
+  EXPECT_DOUBLE_EQ(c.estimator.init_scale_motion_max_wait_s, 3.0);
+  const std::string dir = test::scratchDir();
+  const std::string path = test::writeFile(
+      dir + "/scale_motion.yaml",
+      eurocYamlReplacing("init_min_scale_motion_m: 0.005", "init_min_scale_motion_m: -0.005"));
+  expectErrorMentioning([&] { Config::load(path); },
+                        {"estimator.init_min_scale_motion_m", "must not be negative"});
+}
+
 TEST(Config, LineMapFilterIsReadAndANegativeParallaxIsRejected) {
   const Config c = Config::load(test::sourcePath("config/euroc.yaml"));
   EXPECT_DOUBLE_EQ(c.estimator.line_map_max_rms_px, 0.5);
