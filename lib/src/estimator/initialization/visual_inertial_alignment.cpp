@@ -97,13 +97,12 @@ LinearSolution solveLinear(const std::vector<AlignmentFrame>& frames, const Eige
   const Eigen::LDLT<Eigen::MatrixXd> ldlt(A);
   LinearSolution solution;
   solution.x = ldlt.solve(b);
+  const double inverse_ss = kConditioning * ldlt.solve(Eigen::VectorXd::Unit(n, n - 1))[n - 1];
+  solution.scale_sigma_per_noise = std::sqrt(std::max(0.0, inverse_ss));
   const int rows = 6 * (n_frames - 1);
   if (rows > n) {
     const double rss = zz - solution.x.dot(b) / kConditioning;
-    const double variance = std::max(0.0, rss) / (rows - n);
-    const double inverse_ss = kConditioning * ldlt.solve(Eigen::VectorXd::Unit(n, n - 1))[n - 1];
-    solution.scale_sigma_per_noise = std::sqrt(std::max(0.0, inverse_ss));
-    solution.residual_rms = std::sqrt(variance);
+    solution.residual_rms = std::sqrt(std::max(0.0, rss) / (rows - n));
   }
   return solution;
 }
