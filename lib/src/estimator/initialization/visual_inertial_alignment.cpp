@@ -138,6 +138,10 @@ bool alignVisualInertial(std::vector<AlignmentFrame>& frames, const Eigen::Vecto
     g0 = (g0 + B * x.segment<2>(3 * n_frames)).normalized() * gravity_magnitude;
   }
   scale = x[3 * n_frames + 2] / 100.0;
+  if (scale < 0) {
+    result->failure = "negative scale after gravity refinement";
+    return false;
+  }
   // sigma(s) / s = noise / (100 s / sigma per noise): the quotient is a length.
   const double motion = 100.0 * scale / refined.scale_sigma_per_noise;
   result->scale_motion_m = std::isfinite(motion) ? motion : 0.0;
