@@ -71,15 +71,14 @@ class FrameImuSynchronizer {
       : options_(options) {}
 
   ImuAdded addImu(const ImuSample& sample) {
+    const int64_t newest_before = imu_clock_.newest();
     last_jump_ns_ = imu_clock_.follow(sample.t_ns);
     if (last_jump_ns_) {
       startNewRun();
-    } else if (have_imu_ && sample.t_ns <= newest_imu_ns_) {
+    } else if (staleStamp(sample.t_ns, newest_before)) {
       ++counts_.imu_late;
       return ImuAdded::kLate;
     }
-    have_imu_ = true;
-    newest_imu_ns_ = sample.t_ns;
     imu_.push_back(sample);
     if (imu_.size() > options_.max_imu) {
       imu_.pop_front();
@@ -131,8 +130,8 @@ class FrameImuSynchronizer {
 
   /// The oldest waiting frame once the IMU has passed its time, else nothing.
   std::optional<Ready> pop() {
-    if (frames_.empty() || !have_imu_ || newest_imu_ns_ <= frames_.front().first)
-      return std::nullopt;
+    // The newest IMU stamp is 0 before any sample.
+    if (frames_.empty() || imu_clock_.newest() <= frames_.front().first) return std::nullopt;
     Ready ready;
     ready.t_ns = frames_.front().first;
     ready.frame = std::move(frames_.front().second);
@@ -168,7 +167,7 @@ class FrameImuSynchronizer {
   void startNewRun() {
     frames_.clear();
     imu_.clear();
-    have_imu_ = released_any_ = false;
+    released_any_ = false;
     last_released_ns_ = 0;
     counts_ = FrameImuSyncCounts();
     Queue held;
@@ -184,11 +183,11 @@ class FrameImuSynchronizer {
   FrameImuSyncOptions options_;
   Queue frames_, held_;
   std::deque<ImuSample> imu_;
-  bool have_imu_ = false, released_any_ = false;
-  int64_t newest_imu_ns_ = 0, last_released_ns_ = 0;
+  bool released_any_ = false;
+  int64_t last_released_ns_ = 0;
   int64_t newest_frame_ns_ = 0;  // follows the camera's clock, to see it jump back first
   int64_t last_jump_ns_ = 0;
-  ClockWatch imu_clock_;
+  ClockWatch imu_clock_;  // the newest IMU stamp, and its jumps back
   FrameImuSyncCounts counts_;
 };
 
