@@ -190,14 +190,14 @@ TEST(Config, AnUnknownRobustLossIsRejectedByName) {
 
 TEST(Config, GyroscopeFlowSettingsAreReadAndNegativeLevelsRejectedByName) {
   const Config c = Config::load(test::sourcePath("config/euroc.yaml"));
-  EXPECT_FALSE(c.points.gyro_flow);
+  EXPECT_TRUE(c.points.gyro_flow);
   EXPECT_TRUE(c.lines.flow.gyro_flow);
-  EXPECT_EQ(c.points.gyro_klt_levels, 1);
+  EXPECT_EQ(c.points.gyro_klt_levels, 3);
   EXPECT_EQ(c.lines.flow.gyro_klt_levels, 1);
   const std::string dir = test::scratchDir();
   const std::string points =
       test::writeFile(dir + "/points.yaml",
-                      eurocYamlReplacing("  gyro_klt_levels: 1\n", "  gyro_klt_levels: -1\n"));
+                      eurocYamlReplacing("  gyro_klt_levels: 3\n", "  gyro_klt_levels: -1\n"));
   expectErrorMentioning([&] { Config::load(points); },
                         {"points.gyro_klt_levels", "must not be negative"});
   const std::string lines = test::writeFile(

@@ -28,8 +28,9 @@ struct PointTrackerOptions {
   int klt_levels = 3;
   /// Start KLT where the gyroscope's rotation since the last frame moves each corner (when the
   /// caller passes that rotation), with gyro_klt_levels pyramid levels above the image; corners
-  /// that fail there try again on all klt_levels. Off by default: on one level the corners
-  /// err more in dim light (docs/benchmarks.md, thirty-first session).
+  /// that fail there try again on all klt_levels. config/euroc.yaml turns it on with all three
+  /// levels: on one level the corners err more in dim light (docs/benchmarks.md, thirty-first
+  /// and fifty-eighth sessions).
   bool gyro_flow = false;
   int gyro_klt_levels = 1;
   bool forward_backward_check = true;  ///< track back and reject points that do not return
