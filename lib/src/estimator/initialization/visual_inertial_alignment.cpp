@@ -36,25 +36,31 @@ Eigen::Matrix<double, 3, 2> tangentBasis(const Eigen::Vector3d& g) {
   return B;
 }
 
-struct LinearSolution {
-  Eigen::VectorXd x;  ///< [v_0..v_n, gravity terms, 100 s]
-  /// The last unknown's (100 s) standard deviation for rows of unit noise: how weakly the
-  /// window's motion ties the scale down, whatever the noise.
-  double scale_sigma_per_noise = 0;
-  double residual_rms = 0;  ///< of the rows (m, m/s)
+// Scales the normal equations (not zz) for a better-conditioned solve.
+constexpr double kConditioning = 1000.0;
+
+// The normal equations over [v_0..v_n (body frames), gravity terms, 100 s].
+struct LinearSystem {
+  Eigen::MatrixXd A;
+  Eigen::VectorXd b;
+  double zz = 0;  ///< sum of z'z: with x'b it gives the residuals' sum of squares
+  int rows = 0;   ///< of the stacked system
 };
 
-// Builds and solves the linear system over [v_0..v_n (body frames), gravity terms, scale].
-// With `g_fixed` given, gravity is g_fixed + B w (2 unknowns); otherwise it is 3 unknowns.
-LinearSolution solveLinear(const std::vector<AlignmentFrame>& frames, const Eigen::Vector3d& t_b_c,
-                           const Eigen::Vector3d* g_fixed, const Eigen::Matrix<double, 3, 2>* B) {
+// Builds the normal equations. With `g_fixed` given, gravity is g_fixed + B w (2 unknowns);
+// otherwise it is 3 unknowns. Scale is estimated as 100 s so the unknowns are of similar
+// magnitude.
+LinearSystem buildLinearSystem(const std::vector<AlignmentFrame>& frames,
+                               const Eigen::Vector3d& t_b_c, const Eigen::Vector3d* g_fixed,
+                               const Eigen::Matrix<double, 3, 2>* B) {
   const int n_frames = static_cast<int>(frames.size());
   const int n_g = g_fixed ? 2 : 3;
   const int n = 3 * n_frames + n_g + 1;
   const int extra = n_g + 1;
-  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(n, n);
-  Eigen::VectorXd b = Eigen::VectorXd::Zero(n);
-  double zz = 0;  // sum of z'z: with x'b it gives the residuals' sum of squares
+  LinearSystem sys;
+  sys.A = Eigen::MatrixXd::Zero(n, n);
+  sys.b = Eigen::VectorXd::Zero(n);
+  sys.rows = 6 * (n_frames - 1);
   for (int k = 1; k < n_frames; ++k) {
     const auto& fi = frames[k - 1];
     const auto& fj = frames[k];
@@ -78,31 +84,44 @@ LinearSolution solveLinear(const std::vector<AlignmentFrame>& frames, const Eige
       H.block<3, 3>(0, 6) = Gp;
       H.block<3, 3>(3, 6) = Gv;
     }
-    // Scale is estimated as 100 s so the unknowns are of similar magnitude.
     H.block<3, 1>(0, 6 + n_g) = RiT * (fj.p_c0_c - fi.p_c0_c) / 100.0;
-    zz += z.squaredNorm();
+    sys.zz += z.squaredNorm();
     const Eigen::MatrixXd HtH = H.transpose() * H;
     const Eigen::VectorXd Htz = H.transpose() * z;
     const int iv = 3 * (k - 1);
-    A.block(iv, iv, 6, 6) += HtH.topLeftCorner(6, 6);
-    b.segment(iv, 6) += Htz.head(6);
-    A.bottomRightCorner(extra, extra) += HtH.bottomRightCorner(extra, extra);
-    b.tail(extra) += Htz.tail(extra);
-    A.block(iv, n - extra, 6, extra) += HtH.topRightCorner(6, extra);
-    A.block(n - extra, iv, extra, 6) += HtH.bottomLeftCorner(extra, 6);
+    sys.A.block(iv, iv, 6, 6) += HtH.topLeftCorner(6, 6);
+    sys.b.segment(iv, 6) += Htz.head(6);
+    sys.A.bottomRightCorner(extra, extra) += HtH.bottomRightCorner(extra, extra);
+    sys.b.tail(extra) += Htz.tail(extra);
+    sys.A.block(iv, n - extra, 6, extra) += HtH.topRightCorner(6, extra);
+    sys.A.block(n - extra, iv, extra, 6) += HtH.bottomLeftCorner(extra, 6);
   }
-  constexpr double kConditioning = 1000.0;
-  A *= kConditioning;
-  b *= kConditioning;
-  const Eigen::LDLT<Eigen::MatrixXd> ldlt(A);
+  sys.A *= kConditioning;
+  sys.b *= kConditioning;
+  return sys;
+}
+
+struct LinearSolution {
+  Eigen::VectorXd x;  ///< [v_0..v_n, gravity terms, 100 s]
+  /// The last unknown's (100 s) standard deviation for rows of unit noise: how weakly the
+  /// window's motion ties the scale down, whatever the noise.
+  double scale_sigma_per_noise = 0;
+  double residual_rms = 0;  ///< of the rows (m, m/s)
+};
+
+// Solves the system; with `quality`, also the scale's spread and the residuals' (the
+// unrefined first solve only needs x).
+LinearSolution solveLinear(const LinearSystem& sys, bool quality) {
+  const int n = static_cast<int>(sys.b.size());
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(sys.A);
   LinearSolution solution;
-  solution.x = ldlt.solve(b);
+  solution.x = ldlt.solve(sys.b);
+  if (!quality) return solution;
   const double inverse_ss = kConditioning * ldlt.solve(Eigen::VectorXd::Unit(n, n - 1))[n - 1];
   solution.scale_sigma_per_noise = std::sqrt(std::max(0.0, inverse_ss));
-  const int rows = 6 * (n_frames - 1);
-  if (rows > n) {
-    const double rss = zz - solution.x.dot(b) / kConditioning;
-    solution.residual_rms = std::sqrt(std::max(0.0, rss) / (rows - n));
+  if (sys.rows > n) {
+    const double rss = sys.zz - solution.x.dot(sys.b) / kConditioning;
+    solution.residual_rms = std::sqrt(std::max(0.0, rss) / (sys.rows - n));
   }
   return solution;
 }
@@ -120,7 +139,7 @@ bool alignVisualInertial(std::vector<AlignmentFrame>& frames, const Eigen::Vecto
     frames[k].imu->repropagate(Eigen::Vector3d::Zero(), result->gyro_bias);
 
   const int n_frames = static_cast<int>(frames.size());
-  Eigen::VectorXd x = solveLinear(frames, t_b_c, nullptr, nullptr).x;
+  Eigen::VectorXd x = solveLinear(buildLinearSystem(frames, t_b_c, nullptr, nullptr), false).x;
   Eigen::Vector3d g = x.segment<3>(3 * n_frames);
   double scale = x[3 * n_frames + 3] / 100.0;
   if (std::abs(g.norm() - gravity_magnitude) > 1.0 || scale < 0) {
@@ -133,7 +152,7 @@ bool alignVisualInertial(std::vector<AlignmentFrame>& frames, const Eigen::Vecto
   LinearSolution refined;
   for (int it = 0; it < 4; ++it) {
     const Eigen::Matrix<double, 3, 2> B = tangentBasis(g0);
-    refined = solveLinear(frames, t_b_c, &g0, &B);
+    refined = solveLinear(buildLinearSystem(frames, t_b_c, &g0, &B), true);
     x = refined.x;
     g0 = (g0 + B * x.segment<2>(3 * n_frames)).normalized() * gravity_magnitude;
   }
