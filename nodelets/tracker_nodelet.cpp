@@ -175,6 +175,7 @@ class TrackerNodelet : public GuardedNodelet {
       reset_pending_ = false;
     }
 
+    front_end_->setEstimatorTracking(estimator_tracking_);
     for (const alvio::ImuSample& s : imu) front_end_->addImu(s);
 
     alvio::FrameTiming timing;
@@ -187,7 +188,8 @@ class TrackerNodelet : public GuardedNodelet {
     frame_pub_.publish(out);
   }
 
-  // After an estimator reset the point tracks start afresh, as in the offline pipeline.
+  // After an estimator reset the point tracks start afresh, as in the offline pipeline. Whether
+  // the estimator tracks decides, as there, whether the corners' anchors end tracks.
   void onStatus(const alvio::PipelineStatus::ConstPtr& status) {
     // A new run's first frame (after a clock jump) counts as a reset too, but this tracker
     // started afresh itself when the image clock jumped. A second reset a few frames into the
@@ -197,6 +199,7 @@ class TrackerNodelet : public GuardedNodelet {
     // Fewer resets than before: the estimator was restarted (reloaded, new run).
     if (status->reset_count > reset_count_ && !new_run) reset_pending_ = true;
     reset_count_ = status->reset_count;
+    estimator_tracking_ = status->state == alvio::PipelineStatus::TRACKING;
   }
 
   CoreLogRoute log_route_;
@@ -211,6 +214,7 @@ class TrackerNodelet : public GuardedNodelet {
   int64_t frame_period_ns_ = 50000000, last_t_ns_ = 0;
   int reset_count_ = 0;
   bool reset_pending_ = false;
+  bool estimator_tracking_ = false;  // the latest status's, for the corners' anchors
 };
 
 }  // namespace alvio_ros

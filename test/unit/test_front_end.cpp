@@ -1,6 +1,7 @@
 // The front end: lines tracked in their own thread give exactly the frames of the one-thread
 // front end; the point tracker looks for new corners only once enough are missing, and tracks
-// back only the corners whose anchored patch did not align when asked to.
+// back only the corners whose anchored patch did not align when asked to, and ends tracks whose
+// patch stopped matching before initialisation only when configured to.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -160,4 +161,53 @@ TEST(PointTracker, AlignedCornersSkipTheBackwardCheckAndOccludedOnesStillEnd) {
       }
     }
   }
+}
+
+// A surface whose look changes slowly (here: cross-faded into another texture while it
+// slides) keeps its corners frame to frame, but their first patches stop matching. The
+// anchors end such tracks once the estimator tracks; before it has initialised they may go
+// on (end_mismatched_before_init: false), because its structure from motion needs points
+// shared across the whole window.
+TEST(PointTracker, MismatchedPatchesEndTracksBeforeInitialisationOnlyWhenConfigured) {
+  const Config config = Config::load(test::sourcePath("config/euroc.yaml"));
+  const std::shared_ptr<const CameraModel> camera = CameraModel::create(config.camera);
+  const int w = config.camera.width, h = config.camera.height;
+  const cv::Mat a = test::stretched(test::blurredNoise(cv::Size(w + 100, h), 21, 3.0));
+  const cv::Mat b = test::stretched(test::blurredNoise(cv::Size(w + 100, h), 22, 3.0));
+  const int frames = 12;
+  // The content slides right 2 px a frame while b's share grows by 8 % a frame.
+  const auto view = [&](int k) {
+    const cv::Rect r(100 - 2 * k, 0, w, h);
+    cv::Mat out;
+    cv::addWeighted(a(r), 1.0 - 0.08 * k, b(r), 0.08 * k, 0.0, out);
+    return out;
+  };
+  // How many of the first frame's corners the last frame still tracks.
+  const auto survivors = [&](bool end_before_init, bool estimator_tracking) {
+    PointTrackerOptions options = config.points;
+    options.anchors.enabled = true;
+    options.anchors.end_mismatched = true;
+    options.anchors.end_mismatched_before_init = end_before_init;
+    PointTracker tracker(options, camera);
+    tracker.setEstimatorTracking(estimator_tracking);
+    std::vector<int> first_ids;
+    for (const PointObservation& o : tracker.track(view(0), 0).points) first_ids.push_back(o.id);
+    FeatureFrame last;
+    for (int k = 1; k < frames; ++k) last = tracker.track(view(k), k * 50'000'000LL);
+    int kept = 0;
+    for (const PointObservation& o : last.points)
+      kept += std::count(first_ids.begin(), first_ids.end(), o.id) > 0;
+    return kept;
+  };
+  const int max_features = config.points.max_features;
+  const int tracking = survivors(false, true);
+  const int initialising = survivors(false, false);
+  const int initialising_ending = survivors(true, false);
+  RecordProperty("kept_tracking", tracking);
+  RecordProperty("kept_initialising", initialising);
+  // Frame to frame the corners track: without the anchors' end, nearly all stay.
+  EXPECT_GT(initialising, max_features * 8 / 10);
+  // The first patches no longer match: the anchors end most tracks.
+  EXPECT_LT(tracking, max_features / 4) << initialising << " kept before initialisation";
+  EXPECT_EQ(initialising_ending, tracking) << "end_mismatched_before_init: true ends them too";
 }

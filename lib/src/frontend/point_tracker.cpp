@@ -239,7 +239,8 @@ void PointTracker::alignToAnchors(const cv::Mat& img) {
 }
 
 bool PointTracker::endsTrack(Alignment a) const {
-  return a == Alignment::kMismatch && options_.anchors.end_mismatched;
+  return a == Alignment::kMismatch && options_.anchors.end_mismatched &&
+         (estimator_tracking_ || options_.anchors.end_mismatched_before_init);
 }
 
 void PointTracker::retakePatch(int id, const cv::Mat& img, const cv::Point2f& p, Alignment a) {

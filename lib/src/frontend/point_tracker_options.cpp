@@ -34,6 +34,8 @@ PointTrackerOptions PointTrackerOptions::load(const YamlReader& yaml, const std:
   an.min_zncc = yaml.getDouble(a + "min_zncc", an.min_zncc);
   an.warp = yaml.getChoice(a + "warp", an.warp, {"translation", "similarity", "affine"});
   an.end_mismatched = yaml.getBool(a + "end_mismatched", an.end_mismatched);
+  an.end_mismatched_before_init =
+      yaml.getBool(a + "end_mismatched_before_init", an.end_mismatched_before_init);
   an.skip_backward_when_aligned =
       yaml.getBool(a + "skip_backward_when_aligned", an.skip_backward_when_aligned);
   if (an.window < 5 || an.window % 2 == 0)

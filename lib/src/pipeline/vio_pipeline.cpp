@@ -43,6 +43,7 @@ PipelineOutput VioPipeline::addImage(const cv::Mat& gray, int64_t t_ns,
   // After a reset the tracks start again, so re-initialisation sees fresh parallax.
   if (estimator_.resetCount() != resets_before) front_end_.resetPoints();
   out.status = estimator_.status();
+  front_end_.setEstimatorTracking(out.status == EstimatorStatus::kTracking);
   if (out.has_pose) {
     out.state = estimator_.latestState();
     out.optimization = estimator_.lastOptimizationStats();

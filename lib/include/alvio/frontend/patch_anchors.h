@@ -47,6 +47,10 @@ struct PatchAnchorOptions {
   /// corner on an occluding edge (the background sliding behind it) is no 3D point, and its
   /// patch changes while a surface point's only warps. An unconfirmed patch is taken again.
   bool end_mismatched = true;
+  /// Also before the estimator has initialised. Its structure from motion needs points shared
+  /// across the whole window, and in low texture every track ended there counts (corridor
+  /// restarts after a fault); once tracking, the solve needs the check more.
+  bool end_mismatched_before_init = true;
   /// KLT's backward check only for tracks whose patch did not align: an arrival that
   /// aligned to the track's first patch (ZNCC >= min_zncc, within max_shift_px) is taken as
   /// checked. Needs forward_backward_check; not with the corners' gyroscope flow.

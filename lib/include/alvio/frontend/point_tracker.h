@@ -34,6 +34,8 @@ class PointTracker {
                      const std::optional<Eigen::Matrix3d>& R_cur_prev = std::nullopt);
   /// Forget all tracks (after a reset, or an image-size change).
   void reset();
+  /// Whether the estimator is tracking (initialised), for anchors.end_mismatched_before_init.
+  void setEstimatorTracking(bool tracking) { estimator_tracking_ = tracking; }
   /// How many corners the last frame tracked back for the forward-backward check.
   std::size_t lastBackwardChecks() const { return backward_checks_; }
 
@@ -66,7 +68,7 @@ class PointTracker {
                                    const std::vector<cv::Point2f>& px) const;
   void alignToAnchors(const cv::Mat& img);
   /// Whether an alignment ends its track: a confirmed patch that stopped fitting, when
-  /// anchors.end_mismatched.
+  /// anchors.end_mismatched (before initialisation also end_mismatched_before_init).
   bool endsTrack(Alignment a) const;
   /// Takes track `id`'s patch again at `p` when its alignment `a` calls for it.
   void retakePatch(int id, const cv::Mat& img, const cv::Point2f& p, Alignment a);
@@ -78,6 +80,7 @@ class PointTracker {
 
   PointTrackerOptions options_;
   std::shared_ptr<const CameraModel> camera_;
+  bool estimator_tracking_ = false;
   Clahe clahe_;
   CornerDetector corners_;
   PatchAnchors anchors_;

@@ -37,6 +37,8 @@ class FrontEnd {
   /// Start the point tracks afresh (after an estimator reset, so that re-initialisation
   /// sees fresh parallax).
   void resetPoints() { point_tracker_.reset(); }
+  /// Whether the estimator is tracking (initialised): the corners' anchors may act on it.
+  void setEstimatorTracking(bool tracking) { point_tracker_.setEstimatorTracking(tracking); }
 
   const CameraModel& camera() const { return *camera_; }
   std::shared_ptr<const CameraModel> cameraPtr() const { return camera_; }
