@@ -202,6 +202,11 @@ TEST(Config, PatchAnchorSettingsAreReadAndBadOnesAreRejected) {
       dir + "/skip.yaml",
       eurocYamlReplacing("skip_backward_when_aligned: false", "skip_backward_when_aligned: true"));
   EXPECT_TRUE(Config::load(skip).points.anchors.skip_backward_when_aligned);
+  EXPECT_TRUE(c.points.anchors.end_mismatched_before_init);
+  const std::string keep = test::writeFile(
+      dir + "/keep.yaml",
+      eurocYamlReplacing("end_mismatched_before_init: true", "end_mismatched_before_init: false"));
+  EXPECT_FALSE(Config::load(keep).points.anchors.end_mismatched_before_init);
   expectReplacementRejected("    window: 21", "    window: 20", {"points.anchors.window", "odd"});
   expectReplacementRejected("max_shift_px: 1.0", "max_shift_px: 0",
                             {"points.anchors.max_shift_px", "must be positive"});
