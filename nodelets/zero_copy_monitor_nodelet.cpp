@@ -26,7 +26,9 @@ class ZeroCopyMonitorNodelet : public GuardedNodelet {
   void init() override {
     ros::NodeHandle& nh = getNodeHandle();
     ros::NodeHandle& pnh = getPrivateNodeHandle();
-    const std::string image_topic = param(pnh, "image_topic", "/cam0/image_raw");
+    // The tracker's camera topic by default: the same `config_file`'s topics.image.
+    const NodeletConfig config(nh, pnh);
+    const std::string image_topic = param(pnh, "image_topic", config.config().topics.image);
     const std::string frame_topic = param(pnh, "frame_topic", "tracker/frame");
     report_pub_ = pnh.advertise<alvio::ZeroCopyReport>("report", 1, true);
     image_sub_ = nh.subscribe(image_topic, 20, &ZeroCopyMonitorNodelet::onImage, this);
