@@ -45,6 +45,30 @@ TEST(FeatureSelectionOptions, TrackMeasureIsLengthOrCountAndNamesTheKeyOtherwise
   EXPECT_NE(error.find("selection.track_measure"), std::string::npos) << error;
 }
 
+// Counted, points outnumber lines (240 against 35 a frame) and alpha would stay 1; compared
+// by track length (lines 8 frames, points 6) the lines' case is "more", while the weights
+// still count.
+TEST(AdaptiveWeights, AlphasCaseCanComeFromAnotherMeasure) {
+  const FeatureSelectionOptions o;
+  EXPECT_DOUBLE_EQ(adaptiveWeights(240.0, 35.0, o).alpha, 1.0);
+  const FeatureWeights w = adaptiveWeights(240.0, 35.0, 6.0, 8.0, o);
+  EXPECT_DOUBLE_EQ(w.alpha, 5.0);
+  EXPECT_DOUBLE_EQ(w.w_l, 5.0 * 35.0 / (5.0 * 35.0 + 240.0));
+  EXPECT_DOUBLE_EQ(w.M_l, 35.0);
+  EXPECT_DOUBLE_EQ(adaptiveWeights(240.0, 35.0, 6.0, 6.5, o).alpha, 2.2);
+}
+
+TEST(FeatureSelectionOptions, AlphasCaseIsTheTrackMeasureOrLength) {
+  auto load = [](const std::string& text) {
+    return FeatureSelectionOptions::load(YamlReader::fromString(text, "test.yaml"), "selection");
+  };
+  EXPECT_FALSE(load("selection: {adaptive_weighting: true}\n").alpha_case_by_length);
+  EXPECT_TRUE(load("selection: {alpha_case_by: length}\n").alpha_case_by_length);
+  EXPECT_FALSE(load("selection: {alpha_case_by: track_measure}\n").alpha_case_by_length);
+  const std::string error = test::errorOf([&] { load("selection: {alpha_case_by: count}\n"); });
+  EXPECT_NE(error.find("selection.alpha_case_by"), std::string::npos) << error;
+}
+
 TEST(ResidualScales, EqualWeightsLeaveResidualsUnscaled) {
   FeatureWeights equal;  // 0.5 / 0.5
   for (bool normalize : {false, true})

@@ -65,6 +65,9 @@ FeatureSelectionOptions FeatureSelectionOptions::load(const YamlReader& yaml,
   o.similar_band = yaml.getDouble(p + "similar_band", o.similar_band);
   o.weights_by_count = yaml.getChoice(p + "track_measure", o.weights_by_count ? "count" : "length",
                                       {"length", "count"}) == "count";
+  o.alpha_case_by_length =
+      yaml.getChoice(p + "alpha_case_by", o.alpha_case_by_length ? "length" : "track_measure",
+                     {"track_measure", "length"}) == "length";
   o.normalize_weights = yaml.getBool(p + "normalize_weights", o.normalize_weights);
   const bool costs = o.weights_on == WeightTarget::kCosts;
   const std::string weights_on =
@@ -94,13 +97,18 @@ double trackMeasure(double observations, int features, int frames, bool by_count
 }
 
 FeatureWeights adaptiveWeights(double M_p, double M_l, const FeatureSelectionOptions& o) {
+  return adaptiveWeights(M_p, M_l, M_p, M_l, o);
+}
+
+FeatureWeights adaptiveWeights(double M_p, double M_l, double case_p, double case_l,
+                               const FeatureSelectionOptions& o) {
   FeatureWeights w;
   w.M_p = M_p;
   w.M_l = M_l;
   if (M_p <= 0 && M_l <= 0) return w;
-  const double band = o.similar_band * std::max(M_p, M_l);
-  w.alpha =
-      std::abs(M_l - M_p) <= band ? o.alpha_similar : (M_l > M_p ? o.alpha_more : o.alpha_less);
+  const double band = o.similar_band * std::max(case_p, case_l);
+  w.alpha = std::abs(case_l - case_p) <= band ? o.alpha_similar
+                                              : (case_l > case_p ? o.alpha_more : o.alpha_less);
   const double denominator = w.alpha * M_l + M_p;
   w.w_p = M_p / denominator;
   w.w_l = w.alpha * M_l / denominator;

@@ -53,6 +53,11 @@ struct FeatureSelectionOptions {
   /// frame of the window: the paper's "number of tracking", which it says is much larger for
   /// points); false, its mean track length (observations per feature in the window).
   bool weights_by_count = true;
+  /// Which measure picks alpha's case: false, the same M as the weights; true, the mean track
+  /// length even when the weights count tracks. The paper's cases compare the trackers'
+  /// "tracking capability", while its M_p is "much larger than M_l": by count, lines never
+  /// track more than points, and alpha is always alpha_less.
+  bool alpha_case_by_length = false;
   /// Scale the weighted residuals so that points and lines together carry as much
   /// information as unweighted: the weights then move trust between points and lines, not
   /// from the camera to the IMU. Off: the 2w of `weights_on` as it is (equal weights =
@@ -79,6 +84,9 @@ double trackMeasure(double observations, int features, int frames, bool by_count
 
 /// The ALVIO weights for the track measures M_p and M_l.
 FeatureWeights adaptiveWeights(double M_p, double M_l, const FeatureSelectionOptions& options);
+/// The same, with alpha's case decided by comparing `case_p` and `case_l` instead.
+FeatureWeights adaptiveWeights(double M_p, double M_l, double case_p, double case_l,
+                               const FeatureSelectionOptions& options);
 
 /// Factors that multiply the point and line residuals for weights `w`, with
 /// `point_residuals` and `line_residuals` residual blocks in the window (see
