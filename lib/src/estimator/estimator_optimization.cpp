@@ -81,9 +81,9 @@ void Estimator::updateWeights() {
   const FeatureSelectionOptions& o = options_.selection;
   const double M_p = trackMeasure(track_p, stats_.points_tracked, W_ + 1, o.weights_by_count);
   const double M_l = trackMeasure(track_l, stats_.lines_tracked, W_ + 1, o.weights_by_count);
-  const bool case_by_length = o.alpha_case_by_length && o.weights_by_count;
+  // By length, alpha's case; with track_measure: length that is M itself.
   const FeatureWeights w =
-      case_by_length
+      o.alpha_case_by_length
           ? adaptiveWeights(M_p, M_l, trackMeasure(track_p, stats_.points_tracked, W_ + 1, false),
                             trackMeasure(track_l, stats_.lines_tracked, W_ + 1, false), o)
           : adaptiveWeights(M_p, M_l, o);
