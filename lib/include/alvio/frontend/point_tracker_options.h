@@ -28,11 +28,10 @@ struct PointTrackerOptions {
   int klt_levels = 3;
   /// Start KLT where the gyroscope's rotation since the last frame moves each corner (when the
   /// caller passes that rotation), with gyro_klt_levels pyramid levels above the image; corners
-  /// that fail there try again on all klt_levels. config/euroc.yaml turns it on with all three
-  /// levels: on one level the corners err more in dim light (docs/benchmarks.md, thirty-first
-  /// and fifty-eighth sessions).
-  bool gyro_flow = false;
-  int gyro_klt_levels = 1;
+  /// that fail there try again on all klt_levels. On all three levels: on one level the corners
+  /// err more in dim light (docs/benchmarks.md, thirty-first and fifty-eighth sessions).
+  bool gyro_flow = true;
+  int gyro_klt_levels = 3;
   bool forward_backward_check = true;  ///< track back and reject points that do not return
   double forward_backward_max_px = 0.5;
   PatchAnchorOptions anchors;  ///< `points.anchors`: align each track to its anchored patch
