@@ -93,7 +93,7 @@ TEST(Config, NegativeNoiseIsRejected) {
 }
 
 TEST(Config, NegativeSettlingIsRejected) {
-  expectReplacementRejected("init_settle_change: 0.003", "init_settle_change: -1",
+  expectReplacementRejected("init_settle_change: 0.001", "init_settle_change: -1",
                             {"estimator.init_settle_change", "must not be negative"});
 }
 

@@ -84,7 +84,7 @@ struct EstimatorOptions {
   double init_scale_motion_max_wait_s = 3;  ///< ...for this long at most
   /// After alignment the window keeps being optimised, without output, until one frame moves
   /// its scale by less than this fraction (a short burst of motion leaves the scale loose)...
-  double init_settle_change = 0.003;
+  double init_settle_change = 0.001;
   double init_settle_max_s = 1.5;  ///< ...or for this long at most. 0: output at once.
 
   // Failure detection (reset and re-initialise).
