@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <limits>
 #include <map>
 #include <opencv2/imgproc.hpp>
 
@@ -106,6 +107,29 @@ TEST(GyroRotation, NothingUnlessTheSamplesReachBothTimes) {
   ASSERT_TRUE(gyro.cameraRotation(160'000'000, 190'000'000).has_value());
   EXPECT_TRUE(gyro.cameraRotation(160'000'000, 190'000'000)->isApprox(before, 1e-15));
   EXPECT_FALSE(gyro.cameraRotation(150'000'000, 190'000'000).has_value());
+}
+
+TEST(GyroRotation, SkipsSamplesWithNaNOrInfiniteRates) {
+  // The faults suite's corrupted IMU: one sample in three NaN or infinite. The rate is
+  // constant, so the samples left integrate it exactly.
+  const Eigen::Vector3d w(0.4, -1.1, 0.7);
+  GyroRotation gyro(Eigen::Matrix3d::Identity());
+  const double bad[] = {std::numeric_limits<double>::quiet_NaN(),
+                        std::numeric_limits<double>::infinity()};
+  for (int k = 0; k <= 40; ++k) {
+    ImuSample s;
+    s.t_ns = k * 5'000'000;
+    s.gyr = w;
+    if (k % 3 == 1) s.gyr.y() = bad[(k / 3) % 2];
+    gyro.add(s);
+  }
+  EXPECT_EQ(gyro.size(), 27u);
+  const auto R_c1_c0 = gyro.cameraRotation(20'000'000, 170'000'000);
+  ASSERT_TRUE(R_c1_c0.has_value());
+  ASSERT_TRUE(R_c1_c0->allFinite());
+  const Eigen::Matrix3d R_c0_c1 =
+      Eigen::AngleAxisd(w.norm() * 0.15, w.normalized()).toRotationMatrix();
+  EXPECT_TRUE(R_c1_c0->isApprox(R_c0_c1.transpose(), 1e-12));
 }
 
 TEST(RotatedPixels, MovesPixelsAsTheRotationDoesAndKeepsThoseTurnedBehind) {

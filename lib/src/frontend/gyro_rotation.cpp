@@ -9,6 +9,9 @@
 namespace alvio {
 
 void GyroRotation::add(const ImuSample& sample) {
+  // A NaN rate would turn every predicted corner into NaN and end all tracks at once; the
+  // estimator drops such samples too, and the rate between neighbours is interpolated.
+  if (!sample.gyr.allFinite()) return;
   if (!samples_.empty() && sample.t_ns <= samples_.back().t_ns) return;
   samples_.push_back({sample.t_ns, sample.gyr});
 }

@@ -18,7 +18,8 @@ class GyroRotation {
   /// `R_b_c`: the camera's orientation in the body (IMU) frame.
   explicit GyroRotation(const Eigen::Matrix3d& R_b_c) : R_b_c_(R_b_c) {}
 
-  /// Samples must come in time order; one not after the newest is ignored.
+  /// Samples must come in time order; one not after the newest, or with a NaN or infinite
+  /// rate, is ignored.
   void add(const ImuSample& sample);
   void clear() { samples_.clear(); }
 
