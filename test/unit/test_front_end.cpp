@@ -1,10 +1,12 @@
 // The front end: lines tracked in their own thread give exactly the frames of the one-thread
-// front end; the point tracker looks for new corners only once enough are missing, and tracks
-// back only the corners whose anchored patch did not align when asked to, and ends tracks whose
-// patch stopped matching before initialisation only when configured to.
+// front end, and corrupted gyroscope samples leave the tracks as clean ones do; the point tracker
+// looks for new corners only once enough are missing, and tracks back only the corners whose
+// anchored patch did not align when asked to, and ends tracks whose patch stopped matching before
+// initialisation only when configured to.
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <limits>
 #include <map>
 #include <opencv2/imgproc.hpp>
 
@@ -48,6 +50,43 @@ TEST(FrontEnd, LinesInTheirOwnThreadGiveTheSameFrames) {
     lines_seen += b.lines.size();
   }
   EXPECT_GE(lines_seen, 6u * 6u) << "the bars' edges are tracked";
+}
+
+TEST(FrontEnd, CorruptedGyroscopeSamplesLeaveTheTracksAsCleanOnesDo) {
+  // The faults suite's corrupted IMU: one sample in three NaN or infinite. With the
+  // gyroscope's flow on, such a sample used to make every predicted corner NaN.
+  Config config = Config::load(test::sourcePath("config/euroc.yaml"));
+  config.estimator.use_lines = false;
+  ASSERT_TRUE(config.points.gyro_flow);
+  const int w = config.camera.width, h = config.camera.height;
+  const cv::Mat texture = test::stretched(test::blurredNoise(cv::Size(w + 100, h), 7, 3.0));
+  const auto view = [&](int shift) { return texture(cv::Rect(100 - shift, 0, w, h)).clone(); };
+  FrontEnd clean(config), corrupted(config);
+  const int64_t imu_dt = 5'000'000, frame_dt = 50'000'000;
+  int64_t t_imu = 0;
+  std::size_t kept = 0;
+  for (int k = 0; k < 6; ++k) {
+    const int64_t t_ns = k * frame_dt;
+    for (; t_imu <= t_ns + imu_dt; t_imu += imu_dt) {  // up to one sample beyond the image
+      ImuSample s;
+      s.t_ns = t_imu;
+      s.acc = Eigen::Vector3d(0, 0, 9.81);
+      s.gyr = Eigen::Vector3d(0.02, -0.01, 0.03);
+      clean.addImu(s);
+      if ((t_imu / imu_dt) % 3 == 1)
+        s.gyr.x() = (t_imu / imu_dt) % 2 ? std::numeric_limits<double>::quiet_NaN()
+                                         : std::numeric_limits<double>::infinity();
+      corrupted.addImu(s);
+    }
+    const FeatureFrame a = clean.track(view(2 * k), t_ns), b = corrupted.track(view(2 * k), t_ns);
+    ASSERT_EQ(a.points.size(), b.points.size()) << "frame " << k;
+    for (std::size_t i = 0; i < a.points.size(); ++i) {
+      EXPECT_EQ(a.points[i].id, b.points[i].id);
+      EXPECT_NEAR((a.points[i].px - b.points[i].px).norm(), 0.0, 1e-6);
+    }
+    kept = b.points.size();
+  }
+  EXPECT_GE(kept, 100u) << "the corners are tracked through all six frames";
 }
 
 TEST(PointTracker, NewCornersWaitUntilEnoughAreMissing) {
