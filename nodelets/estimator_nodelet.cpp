@@ -234,8 +234,11 @@ class EstimatorNodelet : public GuardedNodelet {
   }
 
   void process(const Sync::Ready& ready) {
-    for (const alvio::ImuSample& s : ready.imu) estimator_->addImu(s);
-    if (!ready.imu.empty()) last_gyr_ = ready.imu.back().gyr;
+    for (const alvio::ImuSample& s : ready.imu) {
+      estimator_->addImu(s);
+      // The odometry's angular rate: the newest finite one (the estimator drops the rest).
+      if (s.gyr.allFinite()) last_gyr_ = s.gyr;
+    }
     const alvio::TrackedFeatures& features = ready.frame->features;
     const auto start = Clock::now();
     const int resets_before = estimator_->resetCount();

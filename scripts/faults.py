@@ -392,15 +392,23 @@ def run_offline(args, env, bag, run_dir, timeout):
             "dropped_imu": s.get("dropped_imu", 0)}
 
 
-def read_statuses(path):
+def read_recorded(path):
+    """The estimator's status messages, and how many odometry messages hold a NaN or Inf (pose
+    or twist: what a robot's controller would read)."""
     import rosbag
-    out = []
+    statuses, bad_odometry = [], 0
     if not path.exists():
-        return out
+        return statuses, bad_odometry
     with rosbag.Bag(str(path)) as b:
-        for _, msg, _ in b.read_messages():
-            out.append(msg)
-    return out
+        for topic, msg, _ in b.read_messages():
+            if topic.endswith("/odometry"):
+                p, q, tw = msg.pose.pose.position, msg.pose.pose.orientation, msg.twist.twist
+                values = [p.x, p.y, p.z, q.x, q.y, q.z, q.w, tw.linear.x, tw.linear.y,
+                          tw.linear.z, tw.angular.x, tw.angular.y, tw.angular.z]
+                bad_odometry += not all(math.isfinite(v) for v in values)
+            else:
+                statuses.append(msg)
+    return statuses, bad_odometry
 
 
 def run_nodelet(args, env, bag, run_dir, timeout):
@@ -419,8 +427,8 @@ def run_nodelet(args, env, bag, run_dir, timeout):
     died = [l for l in launch_log.splitlines() if "process has died" in l]
     if code != 0 or died:
         return {"completed": False, "why": died[0] if died else f"exit status {code}"}
-    statuses = read_statuses(run_dir / "run/status.bag")
-    res = {"completed": True, "status_messages": len(statuses)}
+    statuses, bad_odometry = read_recorded(run_dir / "run/status.bag")
+    res = {"completed": True, "status_messages": len(statuses), "nan_odometry": bad_odometry}
     if statuses:
         last = statuses[-1]
         res.update(resets=int(last.reset_count), frames=int(last.frames),
@@ -435,7 +443,7 @@ def fmt(v, spec="{:.3f}"):
 
 def table(results):
     lines = ["| fault | mode | completed | frames | resets | ATE before (m) | ATE from fault (m) | "
-             "tracking lost | recovery (s) | dropped img / IMU | NaN poses |",
+             "tracking lost | recovery (s) | dropped img / IMU | NaN poses (odometry) |",
              "|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in results:
         done = "yes" if r.get("completed") else f"**no**: {r.get('why', '')}"
@@ -446,7 +454,8 @@ def table(results):
                      f"{r.get('resets', '—')} | "
                      f"{fmt(r.get('ate_before_m'))} | {fmt(r.get('ate_after_m'))} | {lost} | "
                      f"{fmt(r.get('recovery_s'), '{:.2f}')} | {dropped} | "
-                     f"{r.get('nan_poses', '—')} |")
+                     f"{r.get('nan_poses', '—')}"
+                     + (f" ({r['nan_odometry']})" if "nan_odometry" in r else "") + " |")
     return "\n".join(lines)
 
 
@@ -515,9 +524,10 @@ def main():
                 traj = run_dir / "run/trajectory.tum"
             if res.get("completed"):
                 res.update(evaluate(bin_dir, env, fault_gt, traj, fault, t_fault, run_dir))
-                if res["nan_poses"]:
+                if res["nan_poses"] or res.get("nan_odometry"):
                     res["completed"] = False
-                    res["why"] = f"{res['nan_poses']} NaN pose(s)"
+                    res["why"] = (f"{res['nan_poses']} NaN pose(s), "
+                                  f"{res.get('nan_odometry', 0)} odometry message(s) with NaN or Inf")
             res.update(fault=fault.name, mode=mode, what=fault.what)
             results.append(res)
             log(f"    {mode}: " + ", ".join(f"{k}={v}" for k, v in res.items()

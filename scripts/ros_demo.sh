@@ -11,8 +11,8 @@
 #
 # The demo sequence comes from $ALVIO_DEMO_DATA, out/demo/sim, ../data/demo, or is
 # rendered with alvio_sim --demo when that tool is built. --bag plays another bag instead
-# (the ATE needs --groundtruth); --record-status keeps the estimator's status messages in
-# <out>/run/status.bag (the fault-injection suite reads them); --no-logging leaves the MRPT
+# (the ATE needs --groundtruth); --record-status keeps the estimator's status and odometry
+# messages in <out>/run/status.bag (the fault-injection suite reads them); --no-logging leaves the MRPT
 # logger out, as the launch file's default does (latency measurements).
 set -euo pipefail
 
@@ -80,7 +80,8 @@ trap 'kill $core_pid 2>/dev/null || true; wait 2>/dev/null || true' EXIT
 start_private_master "$out" || die "roscore did not start (see $out/roscore.log)"
 
 if $record_status; then
-  rosbag record --quiet -O "$run/status.bag" /alvio/estimator/status __name:=status_recorder \
+  rosbag record --quiet -O "$run/status.bag" /alvio/estimator/status /alvio/estimator/odometry \
+    __name:=status_recorder \
     >"$out/status_record.log" 2>&1 &
   record_pid=$!
 fi
