@@ -63,8 +63,7 @@ bool ArgParser::parse(int argc, char** argv) {
       name = name.substr(0, eq);
     }
     const auto it = specs_.find(name);
-    if (it == specs_.end())
-      throw Error("unknown option '--" + name + "' (see --help)");
+    if (it == specs_.end()) throw Error("unknown option '--" + name + "' (see --help)");
     if (it->second.is_flag) {
       if (has_inline) throw Error("flag '--" + name + "' takes no value");
       values_[name] = "1";
