@@ -97,6 +97,13 @@ TEST(Config, NegativeSettlingIsRejected) {
                             {"estimator.init_settle_change", "must not be negative"});
 }
 
+TEST(Config, BadWarmRestartSettingsAreRejected) {
+  expectReplacementRejected("warm_restart_max_s: 3.0", "warm_restart_max_s: -1",
+                            {"estimator.warm_restart_max_s", "must not be negative"});
+  expectReplacementRejected("warm_restart_min_points: 15", "warm_restart_min_points: 0",
+                            {"estimator.warm_restart_min_points", "must be at least 1"});
+}
+
 TEST(Config, TheWaitForMotionOffConstantVelocityIsReadAndANegativeOneIsRejected) {
   const Config c = Config::load(test::sourcePath("config/euroc.yaml"));
   EXPECT_DOUBLE_EQ(c.estimator.init_min_scale_motion_m, 0.005);

@@ -25,9 +25,11 @@ struct RunOutcome {
   LineSegments3 retired;  // left the window during the run, refined over their tracks
   int resets = 0;
   std::optional<InitializationQuality> init;
-  std::set<std::string> line_schur_structures;  // Ceres's eliminators in solves with lines
-  std::vector<OptimizationStats> first_solves;  // of the first two frames solved
-  std::vector<std::string> waits;               // why initialisation waited, as reported
+  std::set<std::string> line_schur_structures;        // Ceres's eliminators in solves with lines
+  std::vector<OptimizationStats> first_solves;        // of the first two frames solved
+  std::vector<std::string> waits;                     // why initialisation waited, as reported
+  std::vector<std::pair<double, std::string>> inits;  // every initialisation: time, message
+  std::vector<InitializationQuality> init_quality;    // ...and its window against the truth
 };
 
 // `blackout` (seconds from start, [begin, end)) removes the features from those frames:
@@ -73,6 +75,10 @@ RunOutcome runEstimator(const test::SyntheticScenario& s, const Config& c,
     for (const auto& l : estimator.takeRetiredLines()) out.retired.push_back(l);
     for (const auto& e : estimator.takeEvents()) {
       if (e.kind == EstimatorEvent::Kind::kWaiting) out.waits.push_back(e.message);
+      if (e.kind == EstimatorEvent::Kind::kInitialized) {
+        out.inits.emplace_back(e.t - nsToSec(test::SyntheticScenario::kStartNs), e.message);
+        out.init_quality.push_back(initializationQuality(e.window, gt));
+      }
       if (e.kind == EstimatorEvent::Kind::kInitialized && !out.init) {
         out.init = initializationQuality(e.window, gt);
         out.init->time = e.t - nsToSec(test::SyntheticScenario::kStartNs);
@@ -220,6 +226,38 @@ TEST(Estimator, ResetsOnTrackingLossAndKeepsOutputContinuous) {
         << "gap " << a.t - t0 << ".." << b.t - t0 << " s, true step " << true_step.norm() << " m";
   }
   EXPECT_EQ(gaps, 1);
+}
+
+// After a reset the new window starts from the IMU's dead reckoning of the last output, so
+// no structure from motion and no alignment is needed: it starts as soon as every frame of
+// the window sees enough triangulated points, with the old scale. Off, the same blackout
+// waits for the essential matrix's parallax.
+TEST(Estimator, RestartsFromDeadReckoningAfterABlackout) {
+  Config c = Config::load(test::sourcePath("config/euroc.yaml"));
+  ASSERT_GT(c.estimator.warm_restart_max_s, 0);
+  test::ScenarioOptions so;
+  so.duration_s = 12;
+  const test::SyntheticScenario scenario(so, c.camera, c.imu);
+  const RunOutcome warm = runEstimator(scenario, c, {6.0, 6.5});
+  c.estimator.warm_restart_max_s = 0;
+  const RunOutcome cold = runEstimator(scenario, c, {6.0, 6.5});
+  ASSERT_EQ(warm.resets, 1);
+  ASSERT_EQ(cold.resets, 1);
+  ASSERT_EQ(warm.inits.size(), 2u);
+  ASSERT_EQ(cold.inits.size(), 2u);
+  EXPECT_EQ(warm.inits[1].second, "initialised again from IMU dead reckoning");
+  EXPECT_EQ(cold.inits[1].second, "initialised");
+  // A window of frames with points after the blackout, and not much more.
+  EXPECT_LT(warm.inits[1].first, 6.5 + 1.0);
+  EXPECT_LT(warm.inits[1].first, cold.inits[1].first);
+  // The inherited scale and gravity.
+  EXPECT_LT(std::abs(warm.init_quality[1].scale_error), 0.02);
+  EXPECT_LT(warm.init_quality[1].gravity_error_deg, 1.0);
+  for (const RunOutcome* r : {&warm, &cold}) {
+    const EvaluationResult e =
+        evaluateTrajectory(r->trajectory, scenario.groundTruth(), EvaluationOptions());
+    EXPECT_LT(e.ate_translation_m.rmse, 0.1);
+  }
 }
 
 // A spell with only a handful of points (a turn in front of a plain wall, a fast spin) is

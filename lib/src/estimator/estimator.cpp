@@ -84,6 +84,7 @@ void Estimator::clearState() {
   first_steady_alignment_ = -1;
   last_wait_reason_.clear();
   bias_prior_pending_ = false;
+  warm_seeded_ = false;
   settling_ = false;
   settling_positions_.clear();
 }
@@ -110,6 +111,7 @@ void Estimator::addImu(const ImuSample& s) {
     std::snprintf(why, sizeof(why), "IMU clock jumped back %.3f s",
                   (last_queued_imu_ns_ - s.t_ns) * 1e-9);
     reset(s.t(), why);
+    warm_restart_armed_ = false;  // dead reckoning across the jump means nothing
     imu_queue_.clear();
     has_imu_ = false;
     last_queued_imu_ns_ = 0;
@@ -209,9 +211,16 @@ bool Estimator::addFrame(const FeatureFrame& frame, FrameTiming* timing) {
     event(EstimatorEvent::Kind::kWaiting, t, "no IMU data before this frame");
     return false;
   }
+  if (status_ == EstimatorStatus::kInitializing && frame_count_ == 0 && warm_restart_armed_)
+    seedFromDeadReckoning(t);
   marginalization_ = points_.addFrameAndCheckParallax(frame_count_, frame)
                          ? Marginalization::kOld
                          : Marginalization::kSecondNew;
+  // A window that starts with frames without points (the black frames of a camera fault)
+  // cannot initialise: slide them out one a frame, instead of one a keyframe.
+  if (status_ == EstimatorStatus::kInitializing && frame_count_ == W_ &&
+      marginalization_ == Marginalization::kSecondNew && !points_.seenIn(0))
+    marginalization_ = Marginalization::kOld;
   headers_[frame_count_] = t;
   header_ns_[frame_count_] = frame.t_ns;
   intensity_[frame_count_] = frame.mean_intensity;
@@ -355,6 +364,7 @@ void Estimator::reset(double t, const std::string& why) {
     Bgs_[i] = bg.allFinite() && bg.norm() < options_.max_gyro_bias ? bg : Eigen::Vector3d::Zero();
   }
   align_output_after_reset_ = have_output_;
+  warm_restart_armed_ = have_output_ && options_.warm_restart_max_s > 0;
   event(EstimatorEvent::Kind::kReset, t, "reset: " + why);
 }
 
@@ -364,7 +374,7 @@ void Estimator::initialized(double t) {
   e.t = t;
   e.window = windowStates();
   e.scale = init_scale_;
-  e.message = "initialised";
+  e.message = warm_started_ ? "initialised again from IMU dead reckoning" : "initialised";
   events_.push_back(std::move(e));
 }
 
@@ -470,6 +480,29 @@ BodyState Estimator::toOutput(const BodyState& s) const {
   o.q = Eigen::Quaterniond(Rz * s.q.toRotationMatrix()).normalized();
   o.v = Rz * s.v;
   return o;
+}
+
+BodyState Estimator::fromOutput(const BodyState& o) const {
+  const Eigen::Matrix3d Rz_t =
+      Eigen::AngleAxisd(-out_yaw_, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  BodyState s = o;
+  s.p = Rz_t * (o.p - out_to_) + out_from_;
+  s.q = Eigen::Quaterniond(Rz_t * o.q.toRotationMatrix()).normalized();
+  s.v = Rz_t * o.v;
+  return s;
+}
+
+void Estimator::seedFromDeadReckoning(double t) {
+  // The dead-reckoned state is at the time of the IMU fed last: this frame's, unless the IMU
+  // stopped before it.
+  if (!have_output_ || std::abs(dead_reckoned_.t - t) > 1e-3) return;
+  const BodyState s = fromOutput(dead_reckoned_);
+  Ps_[0] = s.p;
+  Vs_[0] = s.v;
+  Rs_[0] = s.q.toRotationMatrix();
+  Bas_[0] = s.ba;
+  Bgs_[0] = s.bg;
+  warm_seeded_ = true;
 }
 
 BodyState Estimator::latestState() const {

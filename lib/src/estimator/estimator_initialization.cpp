@@ -1,6 +1,7 @@
 // Initialisation of the estimator: up-to-scale visual structure from motion
 // over the window, then alignment with the IMU for scale, gravity, velocities
 // and gyroscope bias. Reasons for waiting are reported as events.
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -13,6 +14,19 @@
 namespace alvio {
 
 bool Estimator::initialize(double t) {
+  warm_started_ = false;
+  if (warm_restart_armed_ && warm_seeded_) {
+    const double age = t - last_output_.t;
+    if (age >= 0 && age <= options_.warm_restart_max_s) {
+      if (warmStart(t)) {
+        last_wait_reason_.clear();
+        return true;
+      }
+    } else {
+      warm_restart_armed_ = false;
+      logInfo("warm restart given up: the last output is ", age, " s old; structure from motion");
+    }
+  }
   if (!initialStructure(t)) return false;
   if (!alignWithImu(t)) return false;
   last_wait_reason_.clear();
@@ -215,6 +229,7 @@ bool Estimator::alignWithImu(double t) {
   const double s = result.scale;
   init_scale_ = s;
   bias_prior_pending_ = options_.init_accel_bias_sigma > 0;
+  bias_prior_ba_.setZero();
   bias_prior_bg_ = result.gyro_bias;
   const Eigen::Vector3d t_b_c = T_b_c_.translation();
   for (int i = frame_count_; i >= 0; --i)
@@ -243,6 +258,40 @@ bool Estimator::alignWithImu(double t) {
   logInfo("initialised at t=", stampText(t), ": scale ", s, " (from ", 1000 * result.scale_motion_m,
           " mm of motion off constant velocity, residual rms ", result.residual_rms,
           "), gyroscope bias ", result.gyro_bias.transpose());
+  return true;
+}
+
+bool Estimator::warmStart(double t) {
+  // The window's states are the IMU's propagation of the dead-reckoned state (gravity,
+  // velocity and biases from before the reset): metric already, so no alignment. Depths
+  // from these poses are the solve's start.
+  points_.clearDepths();
+  std::vector<Eigen::Vector3d> P(Ps_.begin(), Ps_.end());
+  std::vector<Eigen::Matrix3d> R(Rs_.begin(), Rs_.end());
+  points_.triangulate(P, R, T_b_c_);
+  // Every frame must see enough of them: frames without (the black ones of a camera fault)
+  // would be held by the IMU alone, and the new scale by a short stretch of images.
+  std::vector<int> seen(W_ + 1, 0);
+  for (const auto& [id, l] : points_.landmarks()) {
+    if (!l.usable(W_) || l.depth <= 0) continue;
+    for (int i = l.start_frame; i <= l.endFrame(); ++i) ++seen[i];
+  }
+  const int placed = *std::min_element(seen.begin(), seen.end());
+  if (placed < options_.warm_restart_min_points) {
+    // Structure from motion is tried next, and logs its own reason to wait.
+    points_.clearDepths();
+    logDebug("warm restart waits: a frame sees ", placed, " of ", options_.warm_restart_min_points,
+             " triangulated points");
+    return false;
+  }
+  init_scale_ = 1.0;
+  bias_prior_pending_ = options_.init_accel_bias_sigma > 0;
+  bias_prior_ba_ = Bas_[0];
+  bias_prior_bg_ = Bgs_[0];
+  warm_restart_armed_ = false;
+  warm_started_ = true;
+  logInfo("initialised again at t=", stampText(t), " from ", t - last_output_.t,
+          " s of IMU dead reckoning (", placed, " points in every frame)");
   return true;
 }
 

@@ -214,7 +214,7 @@ void Estimator::optimize(FrameTiming* timing, int max_iterations, bool triangula
                              last_marginalization_blocks_);
   if (bias_prior_pending_)
     problem.AddResidualBlock(
-        new BiasPriorFactor(Eigen::Vector3d::Zero(), bias_prior_bg_, options_.init_accel_bias_sigma,
+        new BiasPriorFactor(bias_prior_ba_, bias_prior_bg_, options_.init_accel_bias_sigma,
                             options_.init_gyro_bias_sigma),
         nullptr, para_speed_bias_[0].data());
   for (int i = 0; i < frame_count_; ++i) {
@@ -326,8 +326,8 @@ void Estimator::marginalize() {
     if (bias_prior_pending_) {
       // The prior leaves the window with the oldest keyframe: into the marginalisation prior.
       info->addResidualBlock(
-          new BiasPriorFactor(Eigen::Vector3d::Zero(), bias_prior_bg_,
-                              options_.init_accel_bias_sigma, options_.init_gyro_bias_sigma),
+          new BiasPriorFactor(bias_prior_ba_, bias_prior_bg_, options_.init_accel_bias_sigma,
+                              options_.init_gyro_bias_sigma),
           nullptr, {para_speed_bias_[0].data()}, {0});
       bias_prior_pending_ = false;
     }

@@ -62,6 +62,8 @@ EstimatorOptions EstimatorOptions::load(const YamlReader& yaml, const std::strin
       yaml.getDouble(p + "init_scale_motion_max_wait_s", o.init_scale_motion_max_wait_s);
   o.init_settle_change = yaml.getDouble(p + "init_settle_change", o.init_settle_change);
   o.init_settle_max_s = yaml.getDouble(p + "init_settle_max_s", o.init_settle_max_s);
+  o.warm_restart_max_s = yaml.getDouble(p + "warm_restart_max_s", o.warm_restart_max_s);
+  o.warm_restart_min_points = yaml.getInt(p + "warm_restart_min_points", o.warm_restart_min_points);
   o.init_min_excitation = yaml.getDouble(p + "init_min_excitation", o.init_min_excitation);
   o.init_accel_bias_sigma = yaml.getDouble(p + "init_accel_bias_sigma", o.init_accel_bias_sigma);
   o.init_gyro_bias_sigma = yaml.getDouble(p + "init_gyro_bias_sigma", o.init_gyro_bias_sigma);
@@ -83,6 +85,10 @@ EstimatorOptions EstimatorOptions::load(const YamlReader& yaml, const std::strin
     throw Error(yaml.where(p + "init_settle_change") + " must not be negative");
   if (o.init_settle_max_s < 0)
     throw Error(yaml.where(p + "init_settle_max_s") + " must not be negative");
+  if (o.warm_restart_max_s < 0)
+    throw Error(yaml.where(p + "warm_restart_max_s") + " must not be negative (0: off)");
+  if (o.warm_restart_min_points < 1)
+    throw Error(yaml.where(p + "warm_restart_min_points") + " must be at least 1");
   if (o.num_threads < 1) throw Error(yaml.where(p + "num_threads") + " must be at least 1");
   if (o.point_sigma_px <= 0) throw Error(yaml.where(p + "point_sigma_px") + " must be positive");
   if (o.point_drift_px2_per_s < 0)

@@ -177,6 +177,12 @@ int PointLandmarks::usableCount() const {
   return n;
 }
 
+bool PointLandmarks::seenIn(int frame_index) const {
+  for (const auto& [id, l] : landmarks_)
+    if (l.start_frame <= frame_index && frame_index <= l.endFrame()) return true;
+  return false;
+}
+
 Eigen::VectorXd PointLandmarks::inverseDepths() const {
   Eigen::VectorXd v(usableCount());
   int k = 0;

@@ -170,6 +170,8 @@ class Estimator {
   void rememberSettlingWindow();
   double windowScaleChange() const;  // since rememberSettlingWindow(), as a fraction
   BodyState toOutput(const BodyState& s) const;
+  BodyState fromOutput(const BodyState& o) const;  // the inverse of toOutput()
+  void seedFromDeadReckoning(double t);            // options_.warm_restart_max_s
   void event(EstimatorEvent::Kind kind, double t, const std::string& message);
   ImuNoise imuNoise() const;
 
@@ -193,6 +195,7 @@ class Estimator {
   bool initialize(double t);
   bool initialStructure(double t);
   bool alignWithImu(double t);
+  bool warmStart(double t);
 
   EstimatorOptions options_;
   CameraOptions camera_;
@@ -268,7 +271,11 @@ class Estimator {
   int clock_jumps_ = 0;
   double init_scale_ = 0;
   bool bias_prior_pending_ = false;  // the initialisation bias prior is not yet marginalised
-  Eigen::Vector3d bias_prior_bg_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d bias_prior_ba_ = Eigen::Vector3d::Zero(),
+                  bias_prior_bg_ = Eigen::Vector3d::Zero();
+  // Warm restart: armed by a reset that followed an output; the window's first slot then
+  // starts from the dead-reckoned state (seeded), and the others follow by IMU propagation.
+  bool warm_restart_armed_ = false, warm_seeded_ = false, warm_started_ = false;
   bool settling_ = false;  ///< initialised, no output until the scale settles
   double settle_start_ = 0;
   std::map<int64_t, Eigen::Vector3d> settling_positions_;  ///< by frame time

@@ -86,6 +86,12 @@ struct EstimatorOptions {
   /// its scale by less than this fraction (a short burst of motion leaves the scale loose)...
   double init_settle_change = 0.001;
   double init_settle_max_s = 1.5;  ///< ...or for this long at most. 0: output at once.
+  /// After a reset, start the new window from the IMU's dead reckoning of the last output
+  /// (gravity, velocity, biases: the scale is known) instead of structure from motion, when
+  /// that output is at most this old [s] and the window triangulates `warm_restart_min_points`
+  /// points. 0: always structure from motion.
+  double warm_restart_max_s = 3.0;
+  int warm_restart_min_points = 15;
 
   // Failure detection (reset and re-initialise).
   int min_tracked_features = 3;  ///< fewer points + lines tracked into a frame: reset

@@ -58,6 +58,8 @@ class PointLandmarks {
                      const std::function<bool(const PointLandmark&)>& which);
 
   int usableCount() const;
+  /// Whether any landmark was seen in window frame `frame_index`.
+  bool seenIn(int frame_index) const;
   /// Inverse depths of usable landmarks in iteration order, and their write-back.
   Eigen::VectorXd inverseDepths() const;
   void setInverseDepths(const Eigen::VectorXd& inv_depths);
