@@ -100,7 +100,7 @@ TEST(Config, NegativeSettlingIsRejected) {
 TEST(Config, BadWarmRestartSettingsAreRejected) {
   expectReplacementRejected("warm_restart_max_s: 3.0", "warm_restart_max_s: -1",
                             {"estimator.warm_restart_max_s", "must not be negative"});
-  expectReplacementRejected("warm_restart_min_points: 15", "warm_restart_min_points: 0",
+  expectReplacementRejected("warm_restart_min_points: 10", "warm_restart_min_points: 0",
                             {"estimator.warm_restart_min_points", "must be at least 1"});
 }
 

@@ -91,7 +91,7 @@ struct EstimatorOptions {
   /// that output is at most this old [s] and the window triangulates `warm_restart_min_points`
   /// points. 0: always structure from motion.
   double warm_restart_max_s = 3.0;
-  int warm_restart_min_points = 15;
+  int warm_restart_min_points = 10;
 
   // Failure detection (reset and re-initialise).
   int min_tracked_features = 3;  ///< fewer points + lines tracked into a frame: reset
