@@ -34,9 +34,11 @@ struct RunOutcome {
 
 // `blackout` (seconds from start, [begin, end)) removes the features from those frames:
 // all lines, and all points but the `keep_points` of lowest ID.
+// `sparse` (likewise) keeps all lines but only the `sparse_points` points of lowest ID.
 RunOutcome runEstimator(const test::SyntheticScenario& s, const Config& c,
-                        std::pair<double, double> blackout = {-1, -1},
-                        std::size_t keep_points = 0) {
+                        std::pair<double, double> blackout = {-1, -1}, std::size_t keep_points = 0,
+                        std::pair<double, double> sparse = {-1, -1},
+                        std::size_t sparse_points = 0) {
   Estimator estimator(c.estimator, c.camera, c.imu);
   RunOutcome out;
   std::size_t next_imu = 0;
@@ -54,6 +56,10 @@ RunOutcome runEstimator(const test::SyntheticScenario& s, const Config& c,
                 [](const auto& a, const auto& b) { return a.id < b.id; });
       f.points.resize(std::min(keep_points, f.points.size()));
       f.lines.clear();
+    } else if (t_rel >= sparse.first && t_rel < sparse.second) {
+      std::sort(f.points.begin(), f.points.end(),
+                [](const auto& a, const auto& b) { return a.id < b.id; });
+      f.points.resize(std::min(sparse_points, f.points.size()));
     }
     if (estimator.addFrame(f)) {
       const BodyState st = estimator.latestState();
@@ -258,6 +264,26 @@ TEST(Estimator, RestartsFromDeadReckoningAfterABlackout) {
         evaluateTrajectory(r->trajectory, scenario.groundTruth(), EvaluationOptions());
     EXPECT_LT(e.ate_translation_m.rmse, 0.1);
   }
+}
+
+// A reset in front of a plain wall: after the blackout 8 points stay in view, fewer than a
+// warm restart asks every frame to see (and than structure from motion needs), but the lines
+// stay too. They count: the window restarts from dead reckoning and tracks on.
+TEST(Estimator, LinesCountTowardsAWarmRestart) {
+  const Config c = Config::load(test::sourcePath("config/euroc.yaml"));
+  ASSERT_GT(c.estimator.warm_restart_min_points, 8);
+  ASSERT_GT(c.estimator.init_min_correspondences, 8);
+  test::ScenarioOptions so;
+  so.duration_s = 12;
+  const test::SyntheticScenario scenario(so, c.camera, c.imu);
+  const RunOutcome r = runEstimator(scenario, c, {6.0, 6.5}, 0, {6.5, 12.0}, 8);
+  ASSERT_EQ(r.resets, 1);
+  ASSERT_EQ(r.inits.size(), 2u);
+  EXPECT_EQ(r.inits[1].second, "initialised again from IMU dead reckoning");
+  EXPECT_LT(r.inits[1].first, 6.5 + 1.5);
+  const EvaluationResult e =
+      evaluateTrajectory(r.trajectory, scenario.groundTruth(), EvaluationOptions());
+  EXPECT_LT(e.ate_translation_m.rmse, 0.1);
 }
 
 // A spell with only a handful of points (a turn in front of a plain wall, a fast spin) is

@@ -3,6 +3,7 @@
 // and gyroscope bias. Reasons for waiting are reported as events.
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <sstream>
 
 #include "alvio/common/logging.h"
@@ -269,21 +270,35 @@ bool Estimator::warmStart(double t) {
   std::vector<Eigen::Vector3d> P(Ps_.begin(), Ps_.end());
   std::vector<Eigen::Matrix3d> R(Rs_.begin(), Rs_.end());
   points_.triangulate(P, R, T_b_c_);
-  // Every frame must see enough of them: frames without (the black ones of a camera fault)
-  // would be held by the IMU alone, and the new scale by a short stretch of images.
+  // Every frame must see enough of them, or of lines with enough observations to be placed:
+  // frames without (the black ones of a camera fault) would be held by the IMU alone, and the
+  // new scale by a short stretch of images. Lines count as points do (two residuals a frame);
+  // facing a plain wall they are most of what there is.
   std::vector<int> seen(W_ + 1, 0);
   for (const auto& [id, l] : points_.landmarks()) {
     if (!l.usable(W_) || l.depth <= 0) continue;
     for (int i = l.start_frame; i <= l.endFrame(); ++i) ++seen[i];
+  }
+  if (options_.use_lines) {
+    const std::map<int64_t, int> slot = windowSlots();
+    for (const auto& [id, l] : lines_.landmarks()) {
+      if (static_cast<int>(l.observations.size()) < options_.line_min_observations) continue;
+      for (const auto& [ns, o] : l.observations) {
+        const auto it = slot.find(ns);
+        if (it != slot.end()) ++seen[it->second];
+      }
+    }
   }
   const int placed = *std::min_element(seen.begin(), seen.end());
   if (placed < options_.warm_restart_min_points) {
     // Structure from motion is tried next, and logs its own reason to wait.
     points_.clearDepths();
     logDebug("warm restart waits: a frame sees ", placed, " of ", options_.warm_restart_min_points,
-             " triangulated points");
+             " points and lines");
     return false;
   }
+  // Unlike after an alignment, the poses are metric: lines placed now carry no scale error.
+  if (options_.use_lines) lines_.triangulate([this](int64_t ns) { return cameraPose(ns); });
   init_scale_ = 1.0;
   bias_prior_pending_ = options_.init_accel_bias_sigma > 0;
   bias_prior_ba_ = Bas_[0];
@@ -291,7 +306,7 @@ bool Estimator::warmStart(double t) {
   warm_restart_armed_ = false;
   warm_started_ = true;
   logInfo("initialised again at t=", stampText(t), " from ", t - last_output_.t,
-          " s of IMU dead reckoning (", placed, " points in every frame)");
+          " s of IMU dead reckoning (", placed, " points and lines in every frame)");
   return true;
 }
 
