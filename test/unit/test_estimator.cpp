@@ -51,15 +51,16 @@ RunOutcome runEstimator(const test::SyntheticScenario& s, const Config& c,
     if (next_imu < imu.size()) estimator.addImu(imu[next_imu++]);
     const double t_rel = frame.t() - nsToSec(test::SyntheticScenario::kStartNs);
     FeatureFrame f = frame;
-    if (t_rel >= blackout.first && t_rel < blackout.second) {
+    const auto keepLowestIds = [&f](std::size_t n) {
       std::sort(f.points.begin(), f.points.end(),
                 [](const auto& a, const auto& b) { return a.id < b.id; });
-      f.points.resize(std::min(keep_points, f.points.size()));
+      f.points.resize(std::min(n, f.points.size()));
+    };
+    if (t_rel >= blackout.first && t_rel < blackout.second) {
+      keepLowestIds(keep_points);
       f.lines.clear();
     } else if (t_rel >= sparse.first && t_rel < sparse.second) {
-      std::sort(f.points.begin(), f.points.end(),
-                [](const auto& a, const auto& b) { return a.id < b.id; });
-      f.points.resize(std::min(sparse_points, f.points.size()));
+      keepLowestIds(sparse_points);
     }
     if (estimator.addFrame(f)) {
       const BodyState st = estimator.latestState();

@@ -88,8 +88,9 @@ struct EstimatorOptions {
   double init_settle_max_s = 1.5;  ///< ...or for this long at most. 0: output at once.
   /// After a reset, start the new window from the IMU's dead reckoning of the last output
   /// (gravity, velocity, biases: the scale is known) instead of structure from motion, when
-  /// that output is at most this old [s] and the window triangulates `warm_restart_min_points`
-  /// points. 0: always structure from motion.
+  /// that output is at most this old [s] and every frame of the window sees
+  /// `warm_restart_min_points` points triangulated from its poses and lines with enough
+  /// observations to be placed. 0: always structure from motion.
   double warm_restart_max_s = 3.0;
   int warm_restart_min_points = 10;
 
