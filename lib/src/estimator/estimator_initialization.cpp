@@ -252,24 +252,25 @@ bool Estimator::alignWithImu(double t) {
     Vs_[i] = rot * Vs_[i];
   }
   // Depths: triangulate in the metric, gravity-aligned window.
-  points_.clearDepths();
-  std::vector<Eigen::Vector3d> P(Ps_.begin(), Ps_.end());
-  std::vector<Eigen::Matrix3d> R(Rs_.begin(), Rs_.end());
-  points_.triangulate(P, R, T_b_c_);
+  triangulatePointsAfresh();
   logInfo("initialised at t=", stampText(t), ": scale ", s, " (from ", 1000 * result.scale_motion_m,
           " mm of motion off constant velocity, residual rms ", result.residual_rms,
           "), gyroscope bias ", result.gyro_bias.transpose());
   return true;
 }
 
-bool Estimator::warmStart(double t) {
-  // The window's states are the IMU's propagation of the dead-reckoned state (gravity,
-  // velocity and biases from before the reset): metric already, so no alignment. Depths
-  // from these poses are the solve's start.
+void Estimator::triangulatePointsAfresh() {
   points_.clearDepths();
   std::vector<Eigen::Vector3d> P(Ps_.begin(), Ps_.end());
   std::vector<Eigen::Matrix3d> R(Rs_.begin(), Rs_.end());
   points_.triangulate(P, R, T_b_c_);
+}
+
+bool Estimator::warmStart(double t) {
+  // The window's states are the IMU's propagation of the dead-reckoned state (gravity,
+  // velocity and biases from before the reset): metric already, so no alignment. Depths
+  // from these poses are the solve's start.
+  triangulatePointsAfresh();
   // Every frame must see enough of them, or of lines with enough observations to be placed:
   // frames without (the black ones of a camera fault) would be held by the IMU alone, and the
   // new scale by a short stretch of images. Lines count as points do (two residuals a frame);

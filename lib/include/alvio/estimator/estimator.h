@@ -196,6 +196,7 @@ class Estimator {
   bool initialStructure(double t);
   bool alignWithImu(double t);
   bool warmStart(double t);
+  void triangulatePointsAfresh();  // every usable point, from the window's current poses
 
   EstimatorOptions options_;
   CameraOptions camera_;
