@@ -283,7 +283,7 @@ bool Estimator::warmStart(double t) {
   if (options_.use_lines) {
     const std::map<int64_t, int> slot = windowSlots();
     for (const auto& [id, l] : lines_.landmarks()) {
-      if (static_cast<int>(l.observations.size()) < options_.line_min_observations) continue;
+      if (!lines_.observedEnough(l)) continue;
       for (const auto& [ns, o] : l.observations) {
         const auto it = slot.find(ns);
         if (it != slot.end()) ++seen[it->second];

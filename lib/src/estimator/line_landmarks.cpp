@@ -159,7 +159,7 @@ LineViews viewsOf(const LineLandmark& l,
 
 void LineLandmarks::triangulate(const std::function<Eigen::Isometry3d(int64_t)>& camera_pose) {
   for (auto& [id, l] : landmarks_) {
-    if (l.hasLine() || static_cast<int>(l.observations.size()) < min_observations_) continue;
+    if (l.hasLine() || !observedEnough(l)) continue;
     PluckerLine line;
     if (triangulateLineMultiView(viewsOf(l, camera_pose), triangulation_, &line) !=
         LineTriangulationStatus::kOk)

@@ -90,10 +90,13 @@ class LineLandmarks {
   /// Recompute the extents of usable lines from their observations.
   void updateExtents(const std::function<Eigen::Isometry3d(int64_t)>& camera_pose);
 
+  /// Enough window observations to be triangulated and used.
+  bool observedEnough(const LineLandmark& l) const {
+    return static_cast<int>(l.observations.size()) >= min_observations_;
+  }
   /// In the optimisation: triangulated, not an outlier, enough observations.
   bool usable(const LineLandmark& l) const {
-    return l.hasLine() && l.status != LineLandmarkStatus::kOutlier &&
-           static_cast<int>(l.observations.size()) >= min_observations_;
+    return l.hasLine() && l.status != LineLandmarkStatus::kOutlier && observedEnough(l);
   }
   int usableCount() const;
   void removeIds(const std::vector<int>& ids);
