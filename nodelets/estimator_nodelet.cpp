@@ -18,6 +18,7 @@
 #include <alvio/MapKeyframe.h>
 #include <alvio/PipelineStatus.h>
 
+#include <algorithm>
 #include <chrono>
 #include <condition_variable>
 #include <filesystem>
@@ -30,6 +31,7 @@
 #include "alvio/io/trajectory_io.h"
 #include "alvio/mapping/estimator_keyframe_feed.h"
 #include "alvio/pipeline/frame_imu_sync.h"
+#include "alvio/pipeline/odometry_covariance.h"
 #include "conversions.h"
 #include "core_log_route.h"
 #include "guarded_nodelet.h"
@@ -89,6 +91,7 @@ class EstimatorNodelet : public GuardedNodelet {
     config_ = c;
     estimator_ = std::make_unique<alvio::Estimator>(c.estimator, c.camera, c.imu);
     feed_ = std::make_unique<alvio::EstimatorKeyframeFeed>(c.camera.T_b_c);
+    covariance_ = std::make_unique<alvio::OdometryCovariance>(c.odometry_covariance);
     path_.header.frame_id = world_frame_;
 
     odometry_pub_ = pnh.advertise<nav_msgs::Odometry>("odometry", 50);
@@ -193,6 +196,7 @@ class EstimatorNodelet : public GuardedNodelet {
     earlier_resets_ += estimator_->resetCount() + 1;
     estimator_ = std::make_unique<alvio::Estimator>(config_.estimator, config_.camera, config_.imu);
     feed_ = std::make_unique<alvio::EstimatorKeyframeFeed>(config_.camera.T_b_c);
+    covariance_->reset();
     trajectory_.clear();
     path_.poses.clear();
     last_event_.clear();
@@ -302,6 +306,11 @@ class EstimatorNodelet : public GuardedNodelet {
     odometry->twist.twist.angular.x = w_b.x();
     odometry->twist.twist.angular.y = w_b.y();
     odometry->twist.twist.angular.z = w_b.z();
+    covariance_->addPosition(state.p);
+    // A calibrated error model (config odometry_covariance), not the window's marginal.
+    const alvio::Covariance6 pose_cov = covariance_->pose(), twist_cov = covariance_->twist();
+    std::copy(pose_cov.begin(), pose_cov.end(), odometry->pose.covariance.begin());
+    std::copy(twist_cov.begin(), twist_cov.end(), odometry->twist.covariance.begin());
     odometry_pub_.publish(odometry);
 
     if (tf_) {
@@ -429,6 +438,7 @@ class EstimatorNodelet : public GuardedNodelet {
   std::thread worker_;
   std::unique_ptr<alvio::Estimator> estimator_;
   std::unique_ptr<alvio::EstimatorKeyframeFeed> feed_;
+  std::unique_ptr<alvio::OdometryCovariance> covariance_;
   alvio::Trajectory trajectory_;
   int finished_runs_ = 0, earlier_resets_ = 0;
   nav_msgs::Path path_;

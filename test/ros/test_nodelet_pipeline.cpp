@@ -49,6 +49,8 @@ struct Recording {
   std::mutex mutex;
   std::vector<int64_t> images;
   std::vector<std::pair<int64_t, alvio::StampedPose>> odometry;
+  // Each odometry message's covariances, in the same order.
+  std::vector<boost::array<double, 36>> pose_covariance, twist_covariance;
   std::vector<int64_t> tf;
   std::vector<alvio::PipelineStatus> statuses;
   // The newest status (an empty one before any). Call under mutex.
@@ -228,6 +230,33 @@ TEST(NodeletPipeline, OdometryAndTfArriveAtTheImageRateWithImageStamps) {
   EXPECT_EQ(status.state, alvio::PipelineStatus::TRACKING);
   // The latency is measured (its size depends on the machine's load: not checked here).
   EXPECT_GT(status.latency_ms, 0.0);
+}
+
+// The odometry's covariance (config odometry_covariance): diagonal, never singular, and the
+// position's and yaw's growing with the path, the twist's constant.
+TEST(NodeletPipeline, OdometryCarriesACovarianceThatGrowsWithThePath) {
+  REQUIRE_DATA();
+  std::lock_guard<std::mutex> lock(g_rec.mutex);
+  ASSERT_FALSE(g_rec.pose_covariance.empty()) << "no odometry";
+  const auto& first = g_rec.pose_covariance.front();
+  const auto& last = g_rec.pose_covariance.back();
+  for (std::size_t m = 0; m < g_rec.pose_covariance.size(); ++m)
+    for (int r = 0; r < 6; ++r)
+      for (int c = 0; c < 6; ++c) {
+        const double pose = g_rec.pose_covariance[m][r * 6 + c];
+        const double twist = g_rec.twist_covariance[m][r * 6 + c];
+        if (r == c) {
+          ASSERT_GT(pose, 0.0) << "message " << m << ", pose row " << r;
+          ASSERT_EQ(twist, g_rec.twist_covariance.front()[r * 6 + c]) << "message " << m;
+          ASSERT_GT(twist, 0.0) << "message " << m << ", twist row " << r;
+        } else {
+          ASSERT_EQ(pose, 0.0) << "message " << m << ", pose " << r << "," << c;
+          ASSERT_EQ(twist, 0.0) << "message " << m << ", twist " << r << "," << c;
+        }
+      }
+  EXPECT_GT(last[0], first[0]) << "the position's variance must grow as the body moves";
+  EXPECT_GT(last[35], first[35]) << "the yaw's variance must grow as the body moves";
+  EXPECT_EQ(last[21], first[21]) << "roll's variance does not depend on the path";
 }
 
 TEST(NodeletPipeline, AteWithinOneAndAHalfTimesTheOfflineRunners) {
@@ -479,6 +508,8 @@ int main(int argc, char** argv) {
     p.q = Eigen::Quaterniond(q.w, q.x, q.y, q.z).normalized();
     std::lock_guard<std::mutex> lock(g_rec.mutex);
     g_rec.odometry.emplace_back(static_cast<int64_t>(m->header.stamp.toNSec()), p);
+    g_rec.pose_covariance.push_back(m->pose.covariance);
+    g_rec.twist_covariance.push_back(m->twist.covariance);
   };
   auto onTf = [](const tf2_msgs::TFMessageConstPtr& m) {
     std::lock_guard<std::mutex> lock(g_rec.mutex);

@@ -46,6 +46,7 @@ Config Config::load(const YamlReader& yaml) {
   c.estimator = EstimatorOptions::load(yaml, "estimator");
   c.lines = LineTrackerOptions::load(yaml, "lines");
   c.logger = LoggerOptions::load(yaml, "logger");
+  c.odometry_covariance = OdometryCovarianceOptions::load(yaml, "odometry_covariance");
   checkSurfacesFitCamera(c, yaml);
   yaml.markKnown("mapping");  // read by alvio_mapping (MappingOptions::load)
   yaml.warnUnknownKeys();

@@ -9,6 +9,7 @@
 #include "alvio/estimator/estimator_options.h"
 #include "alvio/frontend/point_tracker_options.h"
 #include "alvio/lines/line_tracker_options.h"
+#include "alvio/pipeline/odometry_covariance.h"
 
 namespace alvio {
 
@@ -23,6 +24,7 @@ struct Config {
   EstimatorOptions estimator;
   LineTrackerOptions lines;
   LoggerOptions logger;
+  OdometryCovarianceOptions odometry_covariance;
 
   /// Load and validate `path`. Missing/malformed keys throw alvio::Error naming
   /// file and key; unknown keys are logged as warnings.

@@ -1,0 +1,78 @@
+#include "alvio/pipeline/odometry_covariance.h"
+
+#include <cmath>
+#include <sstream>
+
+#include "alvio/common/error.h"
+#include "alvio/config/yaml_reader.h"
+
+namespace alvio {
+
+namespace {
+constexpr double kDegToRad = M_PI / 180.0;
+
+Covariance6 diagonal(const std::array<double, 6>& sigmas) {
+  Covariance6 c{};
+  for (int i = 0; i < 6; ++i) c[i * 6 + i] = sigmas[i] * sigmas[i];
+  return c;
+}
+}  // namespace
+
+OdometryCovarianceOptions OdometryCovarianceOptions::load(const YamlReader& yaml,
+                                                          const std::string& prefix) {
+  OdometryCovarianceOptions o;
+  const std::string p = prefix + ".";
+  o.position_sigma_m = yaml.getDouble(p + "position_sigma_m", o.position_sigma_m);
+  o.position_drift = yaml.getDouble(p + "position_drift", o.position_drift);
+  o.tilt_sigma_deg = yaml.getDouble(p + "tilt_sigma_deg", o.tilt_sigma_deg);
+  o.yaw_sigma_deg = yaml.getDouble(p + "yaw_sigma_deg", o.yaw_sigma_deg);
+  o.yaw_drift_deg_per_m = yaml.getDouble(p + "yaw_drift_deg_per_m", o.yaw_drift_deg_per_m);
+  o.velocity_sigma_mps = yaml.getDouble(p + "velocity_sigma_mps", o.velocity_sigma_mps);
+  o.angular_rate_sigma_rps = yaml.getDouble(p + "angular_rate_sigma_rps", o.angular_rate_sigma_rps);
+  o.validate(yaml.path() + ": " + prefix);
+  return o;
+}
+
+void OdometryCovarianceOptions::validate(const std::string& where) const {
+  const std::pair<const char*, double> values[] = {
+      {"position_sigma_m", position_sigma_m},
+      {"position_drift", position_drift},
+      {"tilt_sigma_deg", tilt_sigma_deg},
+      {"yaw_sigma_deg", yaw_sigma_deg},
+      {"yaw_drift_deg_per_m", yaw_drift_deg_per_m},
+      {"velocity_sigma_mps", velocity_sigma_mps},
+      {"angular_rate_sigma_rps", angular_rate_sigma_rps}};
+  for (const auto& [key, value] : values) {
+    if (std::isfinite(value) && value >= 0) continue;
+    std::ostringstream os;
+    os << where << "." << key << " must be a finite value >= 0, got " << value;
+    throw Error(os.str());
+  }
+}
+
+void OdometryCovariance::addPosition(const Eigen::Vector3d& p) {
+  if (!p.allFinite()) return;
+  if (has_position_) path_m_ += (p - last_p_).norm();
+  last_p_ = p;
+  has_position_ = true;
+}
+
+void OdometryCovariance::reset() {
+  path_m_ = 0.0;
+  has_position_ = false;
+}
+
+Covariance6 OdometryCovariance::pose() const {
+  const OdometryCovarianceOptions& o = options_;
+  const double position = std::hypot(o.position_sigma_m, o.position_drift * path_m_);
+  const double tilt = o.tilt_sigma_deg * kDegToRad;
+  const double yaw = std::hypot(o.yaw_sigma_deg, o.yaw_drift_deg_per_m * path_m_) * kDegToRad;
+  return diagonal({position, position, position, tilt, tilt, yaw});
+}
+
+Covariance6 OdometryCovariance::twist() const {
+  const double v = options_.velocity_sigma_mps, w = options_.angular_rate_sigma_rps;
+  return diagonal({v, v, v, w, w, w});
+}
+
+}  // namespace alvio

@@ -1,0 +1,227 @@
+#!/usr/bin/python3
+"""How far alvio's odometry is from the truth, component by component, and the
+`odometry_covariance:` sigmas that describe it.
+
+    scripts/odometry_error.py RUN:DATASET [RUN:DATASET ...] [--config YAML]
+
+RUN is an `alvio run --out` folder (trajectory.tum, states.csv); DATASET the EuRoC/ASL folder
+it ran on, with mav0/state_groundtruth_estimate0/data.csv (position, orientation, velocity)
+and mav0/imu0/data.csv. For every output pose the errors are those of the estimator
+nodelet's odometry message:
+
+- position and yaw relative to where the odometry started: both trajectories are put on the
+  first output pose (position and yaw; roll and pitch are gravity's), so the error is the
+  drift since then, against the path travelled (the truth's; the nodelet counts its own
+  output's, which differs by the scale error, a few per cent);
+- tilt: the orientation's error about the world's x and y axes (gravity's direction);
+- velocity in the body frame (R^T v), which no alignment changes;
+- angular rate: the first IMU sample after the frame less the estimated gyroscope bias (what
+  the nodelet publishes), against the truth's rate.
+
+It prints each run's errors, then the sigmas fitted over all runs: velocity and angular rate
+and tilt the largest per-axis RMS, position and yaw the least-squares fit of
+e^2 = s0^2 + (k d)^2. With --config it also prints how often that configuration's model holds
+each error within 1 and 2 sigma (a Gaussian: 68 % and 95 %), to check sigmas on runs that
+did not set them.
+"""
+import argparse
+import sys
+import warnings
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from imu_noise import quat_to_matrix  # scripts/, beside this one
+
+KEYS = ("position_sigma_m", "position_drift", "tilt_sigma_deg", "yaw_sigma_deg",
+        "yaw_drift_deg_per_m", "velocity_sigma_mps", "angular_rate_sigma_rps")
+
+
+def fail(message):
+    sys.exit(f"odometry_error: {message}")
+
+
+def load_table(path, min_columns, delimiter=None, header=0):
+    """The numbers of a text file ('#' comments, `header` lines skipped); exits with a message
+    naming the file if it cannot be read, is empty or has too few columns."""
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # numpy warns about an empty file
+            a = np.loadtxt(path, delimiter=delimiter, comments="#", ndmin=2, skiprows=header)
+    except (OSError, ValueError) as e:
+        fail(f"{path}: cannot read: {e}")
+    if len(a) == 0:
+        fail(f"{path} has no data rows")
+    if a.shape[1] < min_columns:
+        fail(f"{path} has {a.shape[1]} columns, needs {min_columns}")
+    return a
+
+
+def rotation_log(R):
+    """Rotation vectors of rotation matrices (angles below pi), shape (N, 3)."""
+    angle = np.arccos(np.clip((np.trace(R, axis1=1, axis2=2) - 1) / 2, -1, 1))
+    axis = np.stack([R[:, 2, 1] - R[:, 1, 2], R[:, 0, 2] - R[:, 2, 0], R[:, 1, 0] - R[:, 0, 1]], 1)
+    scale = np.where(angle > 1e-9, angle / (2 * np.sin(np.maximum(angle, 1e-9))), 0.5)
+    return axis * scale[:, None]
+
+
+def interpolate_quaternions(t_query, t, q):
+    """Normalised linear interpolation of quaternions (x, y, z, w) sampled densely."""
+    q = q.copy()
+    flip = np.sum(q[1:] * q[:-1], 1) < 0  # one hemisphere, so neighbours blend
+    q[1:][np.cumsum(flip) % 2 == 1] *= -1
+    out = np.stack([np.interp(t_query, t, q[:, k]) for k in range(4)], 1)
+    return out / np.linalg.norm(out, axis=1, keepdims=True)
+
+
+def run_errors(run, dataset):
+    """The errors of one run's output poses (dict of arrays) and the path at each pose."""
+    run, dataset = Path(run), Path(dataset)
+    est = load_table(run / "trajectory.tum", 8)
+    states = load_table(run / "states.csv", 10, delimiter=",", header=1)
+    gt = load_table(dataset / "mav0/state_groundtruth_estimate0/data.csv", 11, delimiter=",")
+    imu = load_table(dataset / "mav0/imu0/data.csv", 4, delimiter=",")
+    if len(states) != len(est) or np.max(np.abs(states[:, 0] - est[:, 0])) > 1e-4:
+        fail(f"{run}: states.csv and trajectory.tum do not have the same poses")
+    t_gt, t_imu = gt[:, 0] * 1e-9, imu[:, 0] * 1e-9
+    inside = (est[:, 0] > t_gt[0] + 0.01) & (est[:, 0] < t_gt[-1] - 0.01)
+    if inside.sum() < 2:
+        fail(f"{run}: fewer than 2 poses inside the ground truth of {dataset}")
+    est, states = est[inside], states[inside]
+    t = est[:, 0]
+    p_gt = np.stack([np.interp(t, t_gt, gt[:, k]) for k in (1, 2, 3)], 1)
+    v_gt = np.stack([np.interp(t, t_gt, gt[:, k]) for k in (8, 9, 10)], 1)
+    q_gt_all = gt[:, [5, 6, 7, 4]]  # EuRoC: w, x, y, z
+    R_gt = quat_to_matrix(interpolate_quaternions(t, t_gt, q_gt_all))
+    R_est = quat_to_matrix(est[:, 4:8])
+
+    # Velocity in the body frame.
+    v_body = np.einsum("nji,nj->ni", R_est, states[:, 1:4])
+    v_body_gt = np.einsum("nji,nj->ni", R_gt, v_gt)
+    # Position and orientation since the first output pose. The orientation's error is
+    # a rotation about the world's axes, as the odometry's covariance has it: about x and y
+    # it is tilt (gravity's), about z yaw.
+    dyaw = -rotation_log(R_est[:1] @ R_gt[:1].transpose(0, 2, 1))[0, 2]
+    c, s = np.cos(dyaw), np.sin(dyaw)
+    Rz = np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
+    p_est = (est[:, 1:4] - est[0, 1:4]) @ Rz.T + p_gt[0]
+    rot_err = np.degrees(rotation_log(np.einsum("ij,njk,nlk->nil", Rz, R_est, R_gt)))
+    path = np.concatenate([[0], np.cumsum(np.linalg.norm(np.diff(p_gt, axis=0), axis=1))])
+    # Angular rate: the first IMU sample after the frame (the last the nodelet is given with
+    # it), less the estimated bias.
+    j = np.clip(np.searchsorted(t_imu, t, side="right"), 0, len(t_imu) - 1)
+    h = 0.0025
+    Rp = quat_to_matrix(interpolate_quaternions(np.clip(t + h, t_gt[0], t_gt[-1]), t_gt, q_gt_all))
+    Rm = quat_to_matrix(interpolate_quaternions(np.clip(t - h, t_gt[0], t_gt[-1]), t_gt, q_gt_all))
+    rate_gt = rotation_log(np.einsum("nji,njk->nik", Rm, Rp)) / (2 * h)
+    rate_err = imu[j, 1:4] - states[:, 7:10] - rate_gt
+    return {"path": path, "position": p_est - p_gt, "yaw": rot_err[:, 2], "tilt": rot_err[:, :2],
+            "velocity": v_body - v_body_gt, "rate": rate_err}
+
+
+def rms(x, axis=0):
+    return np.sqrt(np.mean(np.square(x), axis=axis))
+
+
+def fit_growth(errors_sq, path):
+    """s0, k of e^2 = s0^2 + (k d)^2 by least squares on the squares, both >= 0."""
+    A = np.stack([np.ones_like(path), path ** 2], 1)
+    coef, *_ = np.linalg.lstsq(A, errors_sq, rcond=None)
+    if coef[1] < 0:
+        return float(np.sqrt(np.mean(errors_sq))), 0.0
+    if coef[0] < 0:
+        return 0.0, float(np.sqrt(np.sum(errors_sq * path ** 2) / np.sum(path ** 4)))
+    return float(np.sqrt(coef[0])), float(np.sqrt(coef[1]))
+
+
+def fit(all_errors):
+    e = {k: np.concatenate([r[k] for r in all_errors]) for k in all_errors[0]}
+    n = len(e["path"])
+    s0 = fit_growth(np.square(e["position"]).reshape(-1), np.repeat(e["path"], 3))
+    y0 = fit_growth(np.square(e["yaw"]), e["path"])
+    return {
+        "position_sigma_m": s0[0], "position_drift": s0[1],
+        "tilt_sigma_deg": float(np.max(rms(e["tilt"]))),
+        "yaw_sigma_deg": y0[0], "yaw_drift_deg_per_m": y0[1],
+        "velocity_sigma_mps": float(np.max(rms(e["velocity"]))),
+        "angular_rate_sigma_rps": float(np.max(rms(e["rate"]))),
+    }, n
+
+
+def load_model(path):
+    """The odometry_covariance section of a configuration, its base: files merged in."""
+    def read(p, seen):
+        p = Path(p).resolve()
+        if p in seen:
+            fail(f"{p}: 'base' cycle")
+        try:
+            data = yaml.safe_load(p.read_text()) or {}
+        except (OSError, yaml.YAMLError) as e:
+            fail(f"{p}: cannot read: {e}")
+        section = {}
+        if "base" in data:
+            section = read(p.parent / data["base"], seen | {p})
+        section.update(data.get("odometry_covariance") or {})
+        return section
+    section = read(path, frozenset())
+    unknown = sorted(set(section) - set(KEYS))
+    if unknown:
+        fail(f"{path}: unknown key odometry_covariance.{unknown[0]}")
+    missing = [k for k in KEYS if k not in section]
+    if missing:
+        fail(f"{path}: odometry_covariance.{missing[0]} is not set (give every key to check it)")
+    return {k: float(section[k]) for k in KEYS}
+
+
+def coverage(model, errors):
+    """Fraction of each component's errors within 1 and 2 of the model's sigmas."""
+    d = errors["path"]
+    sp = np.hypot(model["position_sigma_m"], model["position_drift"] * d)
+    sy = np.hypot(model["yaw_sigma_deg"], model["yaw_drift_deg_per_m"] * d)
+    # Normalised errors, one per axis and pose.
+    parts = {
+        "position": np.abs(errors["position"]) / sp[:, None],
+        "yaw": np.abs(errors["yaw"]) / sy,
+        "tilt": np.abs(errors["tilt"]) / model["tilt_sigma_deg"],
+        "velocity": np.abs(errors["velocity"]) / model["velocity_sigma_mps"],
+        "angular rate": np.abs(errors["rate"]) / model["angular_rate_sigma_rps"],
+    }
+    return {name: (float(np.mean(z <= 1)), float(np.mean(z <= 2))) for name, z in parts.items()}
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("runs", nargs="+", metavar="RUN:DATASET")
+    ap.add_argument("--config", help="check this configuration's odometry_covariance sigmas")
+    args = ap.parse_args()
+    all_errors = []
+    print("| run | poses | path (m) | position at the end (m) | yaw RMS (deg) | tilt RMS, larger axis (deg) | "
+          "velocity RMS x/y/z (m/s) | angular rate RMS x/y/z (rad/s) |")
+    print("|---|---|---|---|---|---|---|---|")
+    for spec in args.runs:
+        if ":" not in spec:
+            fail(f"'{spec}' is not RUN:DATASET")
+        run, dataset = spec.split(":", 1)
+        e = run_errors(run, dataset)
+        all_errors.append(e)
+        print(f"| {run} | {len(e['path'])} | {e['path'][-1]:.1f} | "
+              f"{np.linalg.norm(e['position'][-1]):.3f} | {rms(e['yaw']):.3f} | "
+              f"{np.max(rms(e['tilt'])):.3f} | {' / '.join(f'{x:.4f}' for x in rms(e['velocity']))} | "
+              f"{' / '.join(f'{x:.4f}' for x in rms(e['rate']))} |")
+    fitted, n = fit(all_errors)
+    print(f"\nFitted over {len(all_errors)} run(s), {n} poses:\n\nodometry_covariance:")
+    for k in KEYS:
+        print(f"  {k}: {fitted[k]:.4g}")
+    if args.config:
+        model = load_model(args.config)
+        pooled = {k: np.concatenate([r[k] for r in all_errors]) for k in all_errors[0]}
+        print(f"\n{args.config}'s sigmas: share of errors within 1 and 2 sigma "
+              "(a Gaussian: 68 % / 95 %)\n")
+        print("| component | within 1 sigma | within 2 sigma |\n|---|---|---|")
+        for name, (one, two) in coverage(model, pooled).items():
+            print(f"| {name} | {100 * one:.1f} % | {100 * two:.1f} % |")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,199 @@
+"""Tests of scripts/odometry_error.py on a synthetic run: a tilted body flying a circle, an
+"estimate" made from the truth with errors of known size (position and yaw drifting in
+proportion to the path, tilt, body-frame velocity and gyroscope noise), written as alvio run
+writes trajectory.tum and states.csv. The fitted sigmas must give those sizes back, and a
+model with them must hold about 68 % and 95 % of Gaussian errors within 1 and 2 sigma."""
+import os
+import subprocess
+import tempfile
+import unittest
+from pathlib import Path
+
+import numpy as np
+
+from script_failures import CleanFailureAssertions  # test/scripts/, on the path
+
+SCRIPT = Path(__file__).resolve().parents[2] / "scripts" / "odometry_error.py"
+RATE_HZ, CAMERA_EVERY = 200, 10
+DURATION_S = 200.0
+SPEED, RADIUS = 1.0, 5.0              # m/s, m: a 200 m path
+POSITION_DRIFT = 0.002                # m per m travelled, on each axis
+YAW_DRIFT_DEG_PER_M = 0.004
+TILT_SIGMA_DEG = 0.15
+VELOCITY_SIGMA = 0.02                 # m/s, body frame, per axis
+GYRO_SIGMA = 0.003                    # rad/s per sample
+
+
+def rot_z(a):
+    c, s = np.cos(a), np.sin(a)
+    R = np.zeros((len(a), 3, 3))
+    R[:, 0, 0], R[:, 0, 1], R[:, 1, 0], R[:, 1, 1], R[:, 2, 2] = c, -s, s, c, 1
+    return R
+
+
+def small_rotation(v):
+    """Rotation matrices of small rotation vectors (N, 3), Rodrigues' formula."""
+    angle = np.linalg.norm(v, axis=1)
+    u = v / np.maximum(angle, 1e-12)[:, None]
+    K = np.zeros((len(v), 3, 3))
+    K[:, 0, 1], K[:, 0, 2], K[:, 1, 2] = -u[:, 2], u[:, 1], -u[:, 0]
+    K -= K.transpose(0, 2, 1)
+    a = angle[:, None, None]
+    return np.eye(3) + np.sin(a) * K + (1 - np.cos(a)) * (K @ K)
+
+
+def quaternion_xyzw(R):
+    """Quaternions (x, y, z, w) of rotation matrices, from the largest of the four diagonal
+    combinations (the heading turns through 180 degrees, where w alone loses its digits)."""
+    out = np.empty((len(R), 4))
+    d = np.stack([R[:, 0, 0], R[:, 1, 1], R[:, 2, 2], np.trace(R, axis1=1, axis2=2)], 1)
+    pick = np.argmax(d, 1)
+    for n, (m, i) in enumerate(zip(R, pick)):
+        if i == 3:
+            w = np.sqrt(1 + d[n, 3]) / 2
+            q = [(m[2, 1] - m[1, 2]) / (4 * w), (m[0, 2] - m[2, 0]) / (4 * w),
+                 (m[1, 0] - m[0, 1]) / (4 * w), w]
+        else:
+            j, k = (i + 1) % 3, (i + 2) % 3
+            r = np.sqrt(1 + m[i, i] - m[j, j] - m[k, k])
+            q = [0.0, 0.0, 0.0, (m[k, j] - m[j, k]) / (2 * r)]
+            q[i], q[j], q[k] = r / 2, (m[j, i] + m[i, j]) / (2 * r), (m[k, i] + m[i, k]) / (2 * r)
+        out[n] = q
+    return out
+
+
+def make_run(folder, seed):
+    rng = np.random.default_rng(seed)
+    n = int(DURATION_S * RATE_HZ) + 1
+    t_ns = 1_600_000_000_000_000_000 + np.arange(n, dtype=np.int64) * (10**9 // RATE_HZ)
+    t = np.arange(n) / RATE_HZ
+    w = SPEED / RADIUS
+    p = np.stack([RADIUS * np.cos(w * t), RADIUS * np.sin(w * t), 0.2 * np.sin(0.3 * t)], 1)
+    v = np.stack([-SPEED * np.sin(w * t), SPEED * np.cos(w * t), 0.06 * np.cos(0.3 * t)], 1)
+    # Heading along the circle, and a fixed tilt (a camera rig is rarely level): the body's
+    # rate is then the heading's rate about the tilted body's own axis.
+    tilt = small_rotation(np.array([[0.3, -0.2, 0.0]]))[0]
+    R = rot_z(w * t + 1.0) @ tilt
+    rate_body = tilt.T @ np.array([0, 0, w])
+    gt = folder / "data" / "mav0" / "state_groundtruth_estimate0"
+    gt.mkdir(parents=True)
+    q = quaternion_xyzw(R)
+    np.savetxt(gt / "data.csv", np.column_stack([t_ns.astype(float), p, q[:, [3, 0, 1, 2]], v,
+                                                 np.zeros((n, 6))]),
+               delimiter=",", fmt=["%d"] + ["%.12f"] * 16, header="timestamp,...")
+    gyro = rate_body + rng.normal(0, GYRO_SIGMA, (n, 3)) + [0.01, -0.02, 0.005]
+    imu = folder / "data" / "mav0" / "imu0"
+    imu.mkdir(parents=True)
+    np.savetxt(imu / "data.csv", np.column_stack([t_ns.astype(float), gyro, np.zeros((n, 3))]),
+               delimiter=",", fmt=["%d"] + ["%.12f"] * 6, header="timestamp,...")
+    # The estimate at the camera's stamps, 1 ms before an IMU sample (as the IMU runs ahead).
+    k = np.arange(CAMERA_EVERY, n - CAMERA_EVERY, CAMERA_EVERY)
+    tc = t[k] - 0.001
+    stamps = t_ns[k] * 1e-9 - 0.001
+    path = SPEED * (tc - tc[0])
+    # The estimate's own frame: a yaw and an offset the script must take out at its start.
+    frame_yaw, frame_offset = 0.7, np.array([3.0, -2.0, 0.5])
+    pk = np.stack([RADIUS * np.cos(w * tc), RADIUS * np.sin(w * tc), 0.2 * np.sin(0.3 * tc)], 1)
+    vk = np.stack([-SPEED * np.sin(w * tc), SPEED * np.cos(w * tc), 0.06 * np.cos(0.3 * tc)], 1)
+    Rk = rot_z(w * tc + 1.0) @ tilt
+    err_rot = np.column_stack([rng.normal(0, np.radians(TILT_SIGMA_DEG), (len(k), 2)),
+                               np.radians(YAW_DRIFT_DEG_PER_M) * path])
+    R_est = small_rotation(err_rot) @ Rk
+    p_est = pk + POSITION_DRIFT * path[:, None] * np.array([1.0, -1.0, 1.0])
+    # The velocity's error in the estimate's own body frame, as the script measures it.
+    v_body = np.einsum("nji,nj->ni", Rk, vk) + rng.normal(0, VELOCITY_SIGMA, (len(k), 3))
+    v_est = np.einsum("nij,nj->ni", R_est, v_body)
+    F = rot_z(np.array([frame_yaw]))[0]
+    run = folder / "run"
+    run.mkdir()
+    np.savetxt(run / "trajectory.tum",
+               np.column_stack([stamps, p_est @ F.T + frame_offset,
+                                quaternion_xyzw(np.einsum("ij,njk->nik", F, R_est))]),
+               fmt="%.9f", header="timestamp tx ty tz qx qy qz qw")
+    bias = np.tile([0.01, -0.02, 0.005], (len(k), 1))
+    np.savetxt(run / "states.csv", np.column_stack([stamps, v_est @ F.T, np.zeros((len(k), 3)), bias]),
+               delimiter=",", fmt="%.9f", header="t,vx,vy,vz,bax,bay,baz,bgx,bgy,bgz",
+               comments="")
+    return run, folder / "data"
+
+
+def run_script(*args):
+    return subprocess.run(["/usr/bin/python3", str(SCRIPT), *map(str, args)], capture_output=True,
+                          text=True, timeout=120, env=dict(os.environ, PYTHONDONTWRITEBYTECODE="1"))
+
+
+def fitted(stdout):
+    values = {}
+    section = stdout.split("odometry_covariance:", 1)[1]
+    for line in section.splitlines():
+        if line.startswith("  ") and ":" in line:
+            key, value = line.split(":")
+            values[key.strip()] = float(value)
+    return values
+
+
+def coverage(stdout):
+    rows = {}
+    for line in stdout.splitlines():
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if len(cells) == 3 and cells[1].endswith("%"):
+            rows[cells[0]] = (float(cells[1][:-1]), float(cells[2][:-1]))
+    return rows
+
+
+class OdometryErrorTest(CleanFailureAssertions, unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = tempfile.TemporaryDirectory()
+        cls.run_dir, cls.data = make_run(Path(cls.tmp.name), seed=3)
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.tmp.cleanup()
+
+    def test_fit_gives_back_the_errors_it_was_given(self):
+        p = run_script(f"{self.run_dir}:{self.data}")
+        self.assertEqual(p.returncode, 0, p.stderr)
+        got = fitted(p.stdout)
+        self.assertAlmostEqual(got["position_drift"], POSITION_DRIFT, delta=0.05 * POSITION_DRIFT)
+        self.assertLess(got["position_sigma_m"], 0.01)
+        self.assertAlmostEqual(got["yaw_drift_deg_per_m"], YAW_DRIFT_DEG_PER_M,
+                               delta=0.05 * YAW_DRIFT_DEG_PER_M)
+        self.assertLess(got["yaw_sigma_deg"], 0.02)
+        # Random errors: about 2000 poses, a few % of scatter.
+        for key, want in (("tilt_sigma_deg", TILT_SIGMA_DEG),
+                          ("velocity_sigma_mps", VELOCITY_SIGMA),
+                          ("angular_rate_sigma_rps", GYRO_SIGMA)):
+            self.assertAlmostEqual(got[key], want, delta=0.1 * want, msg=key)
+
+    def test_a_model_with_the_true_sigmas_holds_68_and_95_percent(self):
+        config = Path(self.tmp.name) / "model.yaml"
+        config.write_text(
+            "odometry_covariance:\n"
+            f"  position_sigma_m: 0.001\n  position_drift: {POSITION_DRIFT * 1.0001}\n"
+            f"  tilt_sigma_deg: {TILT_SIGMA_DEG}\n  yaw_sigma_deg: 0.01\n"
+            f"  yaw_drift_deg_per_m: {YAW_DRIFT_DEG_PER_M * 1.0001}\n"
+            f"  velocity_sigma_mps: {VELOCITY_SIGMA}\n  angular_rate_sigma_rps: {GYRO_SIGMA}\n")
+        p = run_script(f"{self.run_dir}:{self.data}", "--config", config)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        rows = coverage(p.stdout)
+        for name in ("tilt", "velocity", "angular rate"):
+            one, two = rows[name]
+            self.assertAlmostEqual(one, 68.3, delta=4, msg=name)
+            self.assertAlmostEqual(two, 95.4, delta=2, msg=name)
+        # The drifts are at the model's sigma, just inside it. The floors (1 mm, 0.01 deg) take
+        # the second-order part of the tilt's noise in the yaw and the alignment.
+        for name in ("position", "yaw"):
+            self.assertGreater(rows[name][0], 98.0, name)
+
+    def test_bad_input_is_named(self):
+        self.assertFailsCleanly(run_script(f"{self.run_dir}"), "RUN:DATASET")
+        self.assertFailsCleanly(run_script(f"{self.run_dir}:{self.tmp.name}/nowhere"), "nowhere")
+        config = Path(self.tmp.name) / "partial.yaml"
+        config.write_text("odometry_covariance:\n  position_drift: 0.001\n")
+        self.assertFailsCleanly(run_script(f"{self.run_dir}:{self.data}", "--config", config),
+                                "odometry_covariance.position_sigma_m")
+
+
+if __name__ == "__main__":
+    unittest.main()

@@ -1,0 +1,85 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "alvio/config/config.h"
+#include "alvio/config/yaml_reader.h"
+#include "alvio/pipeline/odometry_covariance.h"
+#include "test_support.h"
+
+using namespace alvio;
+
+namespace {
+constexpr double kDeg = M_PI / 180.0;
+
+OdometryCovarianceOptions someOptions() {
+  OdometryCovarianceOptions o;
+  o.position_sigma_m = 0.03;
+  o.position_drift = 0.002;
+  o.tilt_sigma_deg = 0.2;
+  o.yaw_sigma_deg = 1.0;
+  o.yaw_drift_deg_per_m = 0.01;
+  o.velocity_sigma_mps = 0.01;
+  o.angular_rate_sigma_rps = 0.0025;
+  return o;
+}
+
+void expectDiagonal(const Covariance6& c, const std::array<double, 6>& variances) {
+  for (int r = 0; r < 6; ++r)
+    for (int col = 0; col < 6; ++col)
+      EXPECT_NEAR(c[r * 6 + col], r == col ? variances[r] : 0.0, 1e-15) << r << "," << col;
+}
+}  // namespace
+
+TEST(OdometryCovariance, PositionAndYawGrowWithThePathTiltAndTwistDoNot) {
+  const OdometryCovarianceOptions o = someOptions();
+  OdometryCovariance model(o);
+  const double tilt = std::pow(0.2 * kDeg, 2);
+  // Before any motion: the sigmas at the start.
+  model.addPosition(Eigen::Vector3d(1, 2, 3));
+  expectDiagonal(model.pose(), {9e-4, 9e-4, 9e-4, tilt, tilt, std::pow(kDeg, 2)});
+  // 100 m along a square's sides and back: the path counts, not the distance from the start.
+  for (const Eigen::Vector3d& p : {Eigen::Vector3d(26, 2, 3), Eigen::Vector3d(26, 27, 3),
+                                   Eigen::Vector3d(1, 27, 3), Eigen::Vector3d(1, 2, 3)})
+    model.addPosition(p);
+  EXPECT_NEAR(model.pathLength(), 100.0, 1e-12);
+  const double position = 0.03 * 0.03 + 0.2 * 0.2;  // 0.002 m/m over 100 m
+  const double yaw = (1.0 + 1.0) * kDeg * kDeg;     // 0.01 deg/m over 100 m
+  expectDiagonal(model.pose(), {position, position, position, tilt, tilt, yaw});
+  expectDiagonal(model.twist(), {1e-4, 1e-4, 1e-4, 6.25e-6, 6.25e-6, 6.25e-6});
+  // A new run starts its path again; a non-finite position is not a step.
+  model.reset();
+  model.addPosition(Eigen::Vector3d(50, 0, 0));
+  model.addPosition(Eigen::Vector3d(NAN, 0, 0));
+  model.addPosition(Eigen::Vector3d(53, 4, 0));
+  EXPECT_NEAR(model.pathLength(), 5.0, 1e-12);
+}
+
+TEST(OdometryCovariance, ReadsItsSectionAndNamesABadKey) {
+  const YamlReader yaml = YamlReader::fromString(
+      "odometry_covariance:\n  position_drift: 0.004\n  velocity_sigma_mps: 0.05\n", "robot.yaml");
+  const OdometryCovarianceOptions o = OdometryCovarianceOptions::load(yaml, "odometry_covariance");
+  EXPECT_DOUBLE_EQ(o.position_drift, 0.004);
+  EXPECT_DOUBLE_EQ(o.velocity_sigma_mps, 0.05);
+  EXPECT_DOUBLE_EQ(o.tilt_sigma_deg, OdometryCovarianceOptions().tilt_sigma_deg);
+  for (const char* key : {"position_sigma_m", "yaw_drift_deg_per_m", "angular_rate_sigma_rps"}) {
+    const YamlReader bad = YamlReader::fromString(
+        std::string("odometry_covariance:\n  ") + key + ": -0.1\n", "robot.yaml");
+    const std::string error =
+        test::errorOf([&] { OdometryCovarianceOptions::load(bad, "odometry_covariance"); });
+    EXPECT_NE(error.find("robot.yaml: odometry_covariance." + std::string(key)), std::string::npos)
+        << error;
+  }
+}
+
+TEST(OdometryCovariance, ShippedConfigsGiveTheRealImuWiderSigmas) {
+  const Config euroc = Config::load(test::sourcePath("config/euroc.yaml"));
+  const Config real = Config::load(test::sourcePath("config/euroc_real.yaml"));
+  const OdometryCovarianceOptions& s = euroc.odometry_covariance;
+  const OdometryCovarianceOptions& r = real.odometry_covariance;
+  EXPECT_GT(r.velocity_sigma_mps, s.velocity_sigma_mps);
+  EXPECT_GT(r.angular_rate_sigma_rps, s.angular_rate_sigma_rps);
+  EXPECT_GE(r.position_drift, s.position_drift);
+  EXPECT_GT(s.position_sigma_m, 0.0);
+  EXPECT_GT(s.yaw_sigma_deg, 0.0);
+}
