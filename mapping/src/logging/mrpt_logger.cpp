@@ -474,8 +474,10 @@ void MrptLogger::addPose(const StampedPose& T_w_b) {
   const int64_t t_ns = secToNs(T_w_b.t);
   // CObservationRobotPose: a full 6-DoF pose (CPose3DPDFGaussian) from "an external
   // source", which is what a VIO estimate is to MRPT. CObservationOdometry would hold
-  // only a planar CPose2D increment. The estimator does not export a covariance yet, so
-  // the covariance is left zero.
+  // only a planar CPose2D increment. The covariance is left zero: the odometry's
+  // (odometry_covariance) is over rotations about the world's axes, MRPT's over yaw, pitch
+  // and roll, which degenerate near ±90° of pitch: EuRoC's IMU frame flies with its x axis
+  // up (pitch -67° at MH_05's start).
   auto obs = mrpt::obs::CObservationRobotPose::Create();
   obs->sensorLabel = kPoseLabel;
   obs->timestamp = mrptTime(t_ns);
