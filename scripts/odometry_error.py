@@ -32,7 +32,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from imu_noise import quat_to_matrix  # scripts/, beside this one
+from imu_noise import quat_to_matrix, rotation_log  # scripts/, beside this one
 
 KEYS = ("position_sigma_m", "position_drift", "tilt_sigma_deg", "yaw_sigma_deg",
         "yaw_drift_deg_per_m", "velocity_sigma_mps", "angular_rate_sigma_rps")
@@ -56,14 +56,6 @@ def load_table(path, min_columns, delimiter=None, header=0):
     if a.shape[1] < min_columns:
         fail(f"{path} has {a.shape[1]} columns, needs {min_columns}")
     return a
-
-
-def rotation_log(R):
-    """Rotation vectors of rotation matrices (angles below pi), shape (N, 3)."""
-    angle = np.arccos(np.clip((np.trace(R, axis1=1, axis2=2) - 1) / 2, -1, 1))
-    axis = np.stack([R[:, 2, 1] - R[:, 1, 2], R[:, 0, 2] - R[:, 2, 0], R[:, 1, 0] - R[:, 0, 1]], 1)
-    scale = np.where(angle > 1e-9, angle / (2 * np.sin(np.maximum(angle, 1e-9))), 0.5)
-    return axis * scale[:, None]
 
 
 def interpolate_quaternions(t_query, t, q):
