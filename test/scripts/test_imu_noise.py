@@ -12,7 +12,8 @@ from pathlib import Path
 
 import numpy as np
 
-from script_failures import CleanFailureAssertions  # test/scripts/, on the path
+from rotations import quaternion_xyzw  # test/scripts/, on the path
+from script_failures import CleanFailureAssertions
 
 SCRIPT = Path(__file__).resolve().parents[2] / "scripts" / "imu_noise.py"
 INTERVALS_S = np.array([0.05, 0.1, 0.25, 0.5, 1.0])  # the script's columns
@@ -28,13 +29,6 @@ def rotation(axis, angle):
     K = np.array([[0, -u[2], u[1]], [u[2], 0, -u[0]], [-u[1], u[0], 0]])
     angle = np.atleast_1d(angle)[:, None, None]
     return np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * (K @ K)
-
-
-def quaternion_xyzw(R):
-    """Quaternions of rotations that stay well away from 180 degrees."""
-    w = np.sqrt(1 + np.trace(R, axis1=1, axis2=2)) / 2
-    return np.stack([(R[:, 2, 1] - R[:, 1, 2]) / (4 * w), (R[:, 0, 2] - R[:, 2, 0]) / (4 * w),
-                     (R[:, 1, 0] - R[:, 0, 1]) / (4 * w), w], 1)
 
 
 def make_dataset(folder, gyro_density, accel_density, seed, tum=True, duration_s=DURATION_S):
