@@ -117,6 +117,9 @@ std::vector<T> play(const std::vector<T>& stream, std::size_t play, Stamp stamp)
                         stream.begin() + static_cast<std::ptrdiff_t>(end));
 }
 
+// The estimator's frame queue (frame_queue_size 20 at 20 Hz): what a clock jump may cut.
+constexpr int64_t kOldRunTailNs = 1'000'000'000;
+
 const auto kStampOf = [](int64_t t) { return t; };
 const auto kOdometryStampOf = [](const std::pair<int64_t, alvio::StampedPose>& o) {
   return o.first;
@@ -210,19 +213,25 @@ TEST(NodeletPipeline, OdometryAndTfArriveAtTheImageRateWithImageStamps) {
   ASSERT_FALSE(first_odometry.empty()) << "no odometry: the estimator never initialised";
   const int64_t first = first_odometry.front().first, last = first_odometry.back().first;
   const std::set<int64_t> image_stamps(images.begin(), images.end());
-  const auto after = static_cast<double>(
-      std::count_if(images.begin(), images.end(), [&](int64_t t) { return t >= first; }));
-  const auto tf_after = static_cast<double>(
-      std::count_if(tf.begin(), tf.end(), [&](int64_t t) { return t >= first; }));
-  const double odometry = static_cast<double>(first_odometry.size());
-  std::cout << "images " << images.size() << ", after initialisation " << after << ", odometry "
-            << odometry << ", TF " << tf_after << ", initialised "
+  // A looping player's clock jump ends the first play's run, and by design (frame_imu_sync.h)
+  // drops the old run's frames still queued: the last image, whose IMU sample after it never
+  // comes, and on a loaded machine a backlog of up to the estimator's frame queue (1 s). So the
+  // first play's last second is not counted.
+  const int64_t counted_until = g_settings.replay ? images.back() - kOldRunTailNs : images.back();
+  const auto counted = [&](int64_t t) { return t >= first && t <= counted_until; };
+  const auto after = static_cast<double>(std::count_if(images.begin(), images.end(), counted));
+  const auto tf_after = static_cast<double>(std::count_if(tf.begin(), tf.end(), counted));
+  const auto odometry =
+      static_cast<double>(std::count_if(first_odometry.begin(), first_odometry.end(),
+                                        [&](const auto& o) { return counted(o.first); }));
+  std::cout << "images " << images.size() << ", counted after initialisation " << after
+            << ", odometry " << odometry << ", TF " << tf_after << ", initialised "
             << (first - images.front()) * 1e-9
             << " s after the first image, status: " << status.frames << " frames, "
             << status.dropped_frames << " dropped, " << status.reset_count << " resets\n";
   EXPECT_GE(odometry, 0.95 * after) << "odometry must follow every image once initialised";
   EXPECT_GE(tf_after, 0.95 * after);
-  const double rate = (odometry - 1) / ((last - first) * 1e-9);
+  const double rate = (static_cast<double>(first_odometry.size()) - 1) / ((last - first) * 1e-9);
   EXPECT_NEAR(rate, g_settings.camera_rate_hz, 0.1 * g_settings.camera_rate_hz)
       << "odometry rate in message time";
   for (const auto& [stamp, pose] : first_odometry)
