@@ -11,6 +11,7 @@
 #include <limits>
 #include <memory>
 
+#include "alvio/common/angles.h"
 #include "alvio/common/error.h"
 #include "alvio/config/yaml_reader.h"
 #include "alvio/geometry/line_projection_factor.h"
@@ -19,7 +20,6 @@
 
 namespace alvio {
 namespace {
-constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
 
 Eigen::Vector3d homogeneous(const Eigen::Vector2d& p) {
   return {p.x(), p.y(), 1.0};

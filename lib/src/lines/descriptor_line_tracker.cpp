@@ -3,10 +3,9 @@
 #include <algorithm>
 #include <opencv2/features2d.hpp>
 
+#include "alvio/common/angles.h"
+
 namespace alvio {
-namespace {
-constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
-}
 
 DescriptorLineTracker::DescriptorLineTracker(const CameraOptions& camera,
                                              const LineTrackerOptions& options)

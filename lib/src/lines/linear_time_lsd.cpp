@@ -5,6 +5,7 @@
 #include <limits>
 #include <opencv2/imgproc.hpp>
 
+#include "alvio/common/angles.h"
 #include "alvio/common/widest_vectors.h"
 
 namespace alvio {
@@ -15,7 +16,6 @@ constexpr double kTolerance = CV_PI * kAngleToleranceDeg / 180.0;
 // Probability that a pixel of noise is aligned within the tolerance.
 constexpr double kAlignedProbability = kAngleToleranceDeg / 180.0;
 constexpr int kGradientBins = 1024;
-constexpr double kDegToRad = CV_PI / 180.0;
 constexpr float kNotComputed = std::numeric_limits<float>::quiet_NaN();
 }  // namespace
 

@@ -4,12 +4,12 @@
 #include <algorithm>
 #include <cmath>
 
+#include "alvio/common/angles.h"
 #include "alvio/frontend/pyramidal_klt.h"
 #include "alvio/frontend/rotated_pixels.h"
 
 namespace alvio {
 namespace {
-constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
 // A moved sample further than this from the consensus line is an outlier [px].
 constexpr double kFlowOutlierPx = 2.0;
 // The along-line scale between frames is trusted only within this range (else a shift).

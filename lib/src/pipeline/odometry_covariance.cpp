@@ -3,13 +3,13 @@
 #include <cmath>
 #include <sstream>
 
+#include "alvio/common/angles.h"
 #include "alvio/common/error.h"
 #include "alvio/config/yaml_reader.h"
 
 namespace alvio {
 
 namespace {
-constexpr double kDegToRad = M_PI / 180.0;
 
 Covariance6 diagonal(const std::array<double, 6>& sigmas) {
   Covariance6 c{};
