@@ -33,19 +33,20 @@ EUROC_GT_COLUMNS = ("timestamp", "p_RS_R_x", "p_RS_R_y", "p_RS_R_z", "q_RS_w", "
                     "q_RS_z")
 
 
-def load_table(path, columns, delimiter=None):
-    """The numbers of a text file ('#' comments), one row per line, at least len(columns)
-    columns; exits with a message naming the file if it cannot be read, is empty or is short."""
+def load_table(path, columns, delimiter=None, header=0, program="imu_noise"):
+    """The numbers of a text file ('#' comments, `header` lines skipped), one row per line, at
+    least len(columns) columns; exits with a message naming `program`, the file and the missing
+    column if it cannot be read, is empty or is short."""
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # numpy warns about an empty file
-            a = np.loadtxt(path, delimiter=delimiter, comments="#", ndmin=2)
+            a = np.loadtxt(path, delimiter=delimiter, comments="#", ndmin=2, skiprows=header)
     except (OSError, ValueError) as e:
-        sys.exit(f"imu_noise: {path}: cannot read: {e}")
+        sys.exit(f"{program}: {path}: cannot read: {e}")
     if len(a) == 0:
-        sys.exit(f"imu_noise: {path} has no data rows")
+        sys.exit(f"{program}: {path} has no data rows")
     if a.shape[1] < len(columns):
-        sys.exit(f"imu_noise: {path} has {a.shape[1]} columns, no {columns[a.shape[1]]} "
+        sys.exit(f"{program}: {path} has {a.shape[1]} columns, no {columns[a.shape[1]]} "
                  f"(column {a.shape[1] + 1} of {', '.join(columns)})")
     return a
 

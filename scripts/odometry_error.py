@@ -26,36 +26,31 @@ did not set them.
 """
 import argparse
 import sys
-import warnings
 from pathlib import Path
 
 import numpy as np
 import yaml
 
-from imu_noise import quat_to_matrix, rotation_log  # scripts/, beside this one
+import imu_noise  # scripts/, beside this one
+from imu_noise import quat_to_matrix, rotation_log
 
 KEYS = ("position_sigma_m", "position_drift", "tilt_sigma_deg", "yaw_sigma_deg",
         "yaw_drift_deg_per_m", "velocity_sigma_mps", "angular_rate_sigma_rps")
+
+# The columns read from each file (more may follow).
+TUM_COLUMNS = ("t", "x", "y", "z", "qx", "qy", "qz", "qw")
+STATES_COLUMNS = ("t", "vx", "vy", "vz", "bax", "bay", "baz", "bgx", "bgy", "bgz")
+TRUTH_COLUMNS = ("timestamp", "p_RS_R_x", "p_RS_R_y", "p_RS_R_z", "q_RS_w", "q_RS_x", "q_RS_y",
+                 "q_RS_z", "v_RS_R_x", "v_RS_R_y", "v_RS_R_z")
+IMU_COLUMNS = ("timestamp", "w_RS_S_x", "w_RS_S_y", "w_RS_S_z")
 
 
 def fail(message):
     sys.exit(f"odometry_error: {message}")
 
 
-def load_table(path, min_columns, delimiter=None, header=0):
-    """The numbers of a text file ('#' comments, `header` lines skipped); exits with a message
-    naming the file if it cannot be read, is empty or has too few columns."""
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")  # numpy warns about an empty file
-            a = np.loadtxt(path, delimiter=delimiter, comments="#", ndmin=2, skiprows=header)
-    except (OSError, ValueError) as e:
-        fail(f"{path}: cannot read: {e}")
-    if len(a) == 0:
-        fail(f"{path} has no data rows")
-    if a.shape[1] < min_columns:
-        fail(f"{path} has {a.shape[1]} columns, needs {min_columns}")
-    return a
+def load_table(path, columns, delimiter=None, header=0):
+    return imu_noise.load_table(path, columns, delimiter, header, program="odometry_error")
 
 
 def interpolate_quaternions(t_query, t, q):
@@ -70,10 +65,11 @@ def interpolate_quaternions(t_query, t, q):
 def run_errors(run, dataset):
     """The errors of one run's output poses (dict of arrays) and the path at each pose."""
     run, dataset = Path(run), Path(dataset)
-    est = load_table(run / "trajectory.tum", 8)
-    states = load_table(run / "states.csv", 10, delimiter=",", header=1)
-    gt = load_table(dataset / "mav0/state_groundtruth_estimate0/data.csv", 11, delimiter=",")
-    imu = load_table(dataset / "mav0/imu0/data.csv", 4, delimiter=",")
+    est = load_table(run / "trajectory.tum", TUM_COLUMNS)
+    states = load_table(run / "states.csv", STATES_COLUMNS, delimiter=",", header=1)
+    gt = load_table(dataset / "mav0/state_groundtruth_estimate0/data.csv", TRUTH_COLUMNS,
+                    delimiter=",")
+    imu = load_table(dataset / "mav0/imu0/data.csv", IMU_COLUMNS, delimiter=",")
     if len(states) != len(est) or np.max(np.abs(states[:, 0] - est[:, 0])) > 1e-4:
         fail(f"{run}: states.csv and trajectory.tum do not have the same poses")
     t_gt, t_imu = gt[:, 0] * 1e-9, imu[:, 0] * 1e-9

@@ -175,6 +175,16 @@ class OdometryErrorTest(CleanFailureAssertions, unittest.TestCase):
         self.assertFailsCleanly(run_script(f"{self.run_dir}:{self.data}", "--config", config),
                                 "odometry_covariance.position_sigma_m")
 
+    def test_a_short_file_names_its_missing_column(self):
+        short = Path(self.tmp.name) / "short"
+        short.mkdir(exist_ok=True)
+        (short / "states.csv").write_text((self.run_dir / "states.csv").read_text())
+        lines = (self.run_dir / "trajectory.tum").read_text().splitlines()
+        (short / "trajectory.tum").write_text("".join(" ".join(line.split()[:5]) + "\n"
+                                                      for line in lines))
+        self.assertFailsCleanly(run_script(f"{short}:{self.data}"),
+                                f"{short / 'trajectory.tum'} has 5 columns, no qy (column 6")
+
 
 if __name__ == "__main__":
     unittest.main()
