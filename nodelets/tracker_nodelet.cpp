@@ -49,7 +49,9 @@ class TrackerNodelet : public GuardedNodelet {
     const std::string image_topic = param(pnh, "image_topic", config.config().topics.image);
     const std::string transport = param(pnh, "image_transport", "raw");
     const std::string status_topic = param(pnh, "status_topic", "estimator/status");
-    const int queue = param(pnh, "queue_size", 5);
+    // 1 s of images at 20 Hz, as the estimator's frame queue: a busy moment delays frames
+    // instead of losing them (docs/benchmarks.md, sixty-fourth session).
+    const int queue = param(pnh, "queue_size", 20);
     const std::string imu_topic = param(pnh, "imu_topic", config.config().topics.imu);
     requireParam(!image_topic.empty(), pnh, "image_topic", "is empty");
     requireParam(queue > 0, pnh, "queue_size", "must be positive");
