@@ -37,12 +37,11 @@ from imu_noise import quat_to_matrix, rotation_log
 KEYS = ("position_sigma_m", "position_drift", "tilt_sigma_deg", "yaw_sigma_deg",
         "yaw_drift_deg_per_m", "velocity_sigma_mps", "angular_rate_sigma_rps")
 
-# The columns read from each file (more may follow).
-TUM_COLUMNS = ("t", "x", "y", "z", "qx", "qy", "qz", "qw")
+# The columns read from each file (more may follow); imu_noise.py reads the same formats.
+TUM_COLUMNS = imu_noise.TUM_COLUMNS
 STATES_COLUMNS = ("t", "vx", "vy", "vz", "bax", "bay", "baz", "bgx", "bgy", "bgz")
-TRUTH_COLUMNS = ("timestamp", "p_RS_R_x", "p_RS_R_y", "p_RS_R_z", "q_RS_w", "q_RS_x", "q_RS_y",
-                 "q_RS_z", "v_RS_R_x", "v_RS_R_y", "v_RS_R_z")
-IMU_COLUMNS = ("timestamp", "w_RS_S_x", "w_RS_S_y", "w_RS_S_z")
+TRUTH_COLUMNS = imu_noise.EUROC_GT_COLUMNS + ("v_RS_R_x", "v_RS_R_y", "v_RS_R_z")
+IMU_COLUMNS = imu_noise.IMU_COLUMNS[:4]  # the gyroscope
 
 
 def fail(message):
