@@ -36,13 +36,74 @@ std::vector<std::string> sharedEurocImages() {
   return files;
 }
 
+namespace {
+
+fs::path programScratchRoot() {
+  return fs::temp_directory_path() / ("alvio_test_" + std::to_string(::getpid()));
+}
+
+fs::path testScratchPath(const ::testing::TestInfo& info) {
+  return programScratchRoot() / (std::string(info.test_suite_name()) + "." + info.name());
+}
+
+bool keepAllScratch() {
+  const char* keep = std::getenv("ALVIO_KEEP_SCRATCH");
+  return keep && *keep && std::string(keep) != "0";
+}
+
+// A passed test's scratch goes when it ends, so that repeated runs do not fill /tmp; a failed
+// test's stays, and is named, for a look at what it wrote.
+class ScratchCleanup : public ::testing::EmptyTestEventListener {
+  void OnTestEnd(const ::testing::TestInfo& info) override {
+    const fs::path dir = testScratchPath(info);
+    std::error_code ec;
+    if (!fs::exists(dir, ec)) return;
+    if (info.result()->Failed()) {
+      std::printf("scratch of the failed test kept: %s\n", dir.c_str());
+    } else if (!keepAllScratch()) {
+      fs::remove_all(dir, ec);
+    }
+  }
+};
+
+// The program's shared scratch folders go at exit, and then its root if nothing is left in it.
+std::set<std::string>& sharedScratchDirs() {
+  static auto* dirs = new std::set<std::string>;  // never destroyed: read at exit
+  return *dirs;
+}
+
+void removeProgramScratch() {
+  std::error_code ec;
+  if (!keepAllScratch())
+    for (const auto& dir : sharedScratchDirs()) fs::remove_all(dir, ec);
+  fs::remove(programScratchRoot(), ec);  // only when empty
+}
+
+void registerScratchCleanupOnce() {
+  static const bool registered = [] {
+    ::testing::UnitTest::GetInstance()->listeners().Append(new ScratchCleanup);
+    std::atexit(removeProgramScratch);
+    return true;
+  }();
+  (void)registered;
+}
+
+}  // namespace
+
 std::string scratchDir() {
-  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  const fs::path dir = fs::temp_directory_path() / ("alvio_test_" + std::to_string(::getpid())) /
-                       (std::string(info->test_suite_name()) + "." + info->name());
+  registerScratchCleanupOnce();
+  const fs::path dir = testScratchPath(*::testing::UnitTest::GetInstance()->current_test_info());
   // Emptied on the first call of each test only, so helpers can share it.
   static std::set<std::string> prepared;
   if (prepared.insert(dir.string()).second) fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir.string();
+}
+
+std::string sharedScratchDir(const std::string& name) {
+  registerScratchCleanupOnce();
+  const fs::path dir = programScratchRoot() / name;
+  if (sharedScratchDirs().insert(dir.string()).second) fs::remove_all(dir);  // a reused pid's
   fs::create_directories(dir);
   return dir.string();
 }

@@ -16,8 +16,13 @@ std::string sharedDataDir();
 /// The real EuRoC camera images in the shared data (V1_01, cam0), sorted by name; empty when
 /// the shared data or that folder is missing.
 std::vector<std::string> sharedEurocImages();
-/// A scratch folder unique to the running test, emptied on its first use in the test.
+/// A scratch folder unique to the running test, emptied on its first use in the test. It is
+/// removed when the test passes and kept (its path printed) when it fails; ALVIO_KEEP_SCRATCH=1
+/// keeps them all.
 std::string scratchDir();
+/// A scratch folder named `name` shared by the tests of this program, emptied on its first
+/// use and removed when the program exits.
+std::string sharedScratchDir(const std::string& name);
 /// Path of a file inside the source tree.
 std::string sourcePath(const std::string& relative);
 /// The message of the alvio::Error that `f` throws ("" and a test failure when it throws none).

@@ -13,7 +13,6 @@
 #include <mrpt/opengl/CPointCloud.h>
 #include <mrpt/opengl/CSetOfLines.h>
 #include <mrpt/opengl/CSetOfObjects.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
@@ -139,9 +138,7 @@ const std::string& renderedSequence() {
     so.pixel_noise = 0;   // the rendering decides where blobs are
     so.max_points = 600;  // draw every visible landmark
     test::SyntheticScenario scenario(so, config.camera, config.imu);
-    const fs::path dir =
-        fs::temp_directory_path() / ("alvio_test_" + std::to_string(::getpid())) / "rendered_euroc";
-    fs::remove_all(dir);
+    const fs::path dir = test::sharedScratchDir("rendered_euroc");
     const fs::path mav0 = dir / "mav0";
     fs::create_directories(mav0 / "cam0" / "data");
     fs::create_directories(mav0 / "imu0");
@@ -178,12 +175,6 @@ const std::string& renderedSequence() {
       gt.push_back(s);
     }
     writeEurocGroundTruthCsv((mav0 / "state_groundtruth_estimate0" / "data.csv").string(), gt);
-    std::atexit([] {
-      std::error_code ec;  // the 5 MB sequence goes; the tests' scratch folders stay
-      fs::remove_all(fs::temp_directory_path() / ("alvio_test_" + std::to_string(::getpid())) /
-                         "rendered_euroc",
-                     ec);
-    });
     return dir.string();
   }();
   return root;

@@ -21,7 +21,7 @@ std::string bin(const std::string& tool) {
 // Rendered once for all the tests here (about 8 s on two cores).
 const std::string& sequence() {
   static const std::string dir = [] {
-    const std::string d = test::scratchDir() + "/figure8";
+    const std::string d = test::sharedScratchDir("figure8");
     std::string out;
     if (test::runCommand(bin("alvio_sim") + "--trajectory figure8 --duration 8 --quiet --out " + d,
                          &out) != 0)
@@ -55,7 +55,7 @@ TruthRun runPointTruth(const std::string& args,
 // The oracle, once, with its files written (the two tests below read it).
 const TruthRun& oracleRun() {
   static const TruthRun r = [] {
-    const std::string out = test::scratchDir() + "/oracle";
+    const std::string out = test::sharedScratchDir("oracle");
     TruthRun run = runPointTruth("--oracle --out " + out);
     run.out_dir = out;
     return run;
