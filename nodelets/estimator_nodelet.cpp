@@ -70,8 +70,9 @@ class EstimatorNodelet : public GuardedNodelet {
     const std::string camera_frame = param(pnh, "camera_frame", "cam0");
     publish_tf_ = param(pnh, "publish_tf", true);
     alvio::FrameImuSyncOptions sync_options;
-    const int frame_queue = param(pnh, "frame_queue_size", 20);
-    const int imu_queue = param(pnh, "imu_queue_size", 4000);
+    const int frame_queue =
+        param(pnh, "frame_queue_size", static_cast<int>(sync_options.max_frames));
+    const int imu_queue = param(pnh, "imu_queue_size", static_cast<int>(sync_options.max_imu));
     output_dir_ = param(pnh, "output_dir", "");
     path_max_poses_ = param(pnh, "path_max_poses", 10000);
     flush_after_s_ = param(pnh, "flush_after_s", 1.0);

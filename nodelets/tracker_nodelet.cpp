@@ -49,9 +49,10 @@ class TrackerNodelet : public GuardedNodelet {
     const std::string image_topic = param(pnh, "image_topic", config.config().topics.image);
     const std::string transport = param(pnh, "image_transport", "raw");
     const std::string status_topic = param(pnh, "status_topic", "estimator/status");
-    // 1 s of images at 20 Hz, as the estimator's frame queue: a busy moment delays frames
+    // As many images as the estimator's frame queue (1 s at 20 Hz): a busy moment delays frames
     // instead of losing them (docs/benchmarks.md, sixty-fourth session).
-    const int queue = param(pnh, "queue_size", 20);
+    const int queue =
+        param(pnh, "queue_size", static_cast<int>(alvio::FrameImuSyncOptions().max_frames));
     const std::string imu_topic = param(pnh, "imu_topic", config.config().topics.imu);
     requireParam(!image_topic.empty(), pnh, "image_topic", "is empty");
     requireParam(queue > 0, pnh, "queue_size", "must be positive");

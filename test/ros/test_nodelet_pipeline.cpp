@@ -31,6 +31,7 @@
 #include "alvio/common/clock_jump.h"
 #include "alvio/eval/trajectory_evaluation.h"
 #include "alvio/io/trajectory_io.h"
+#include "alvio/pipeline/frame_imu_sync.h"
 
 namespace fs = std::filesystem;
 
@@ -117,8 +118,12 @@ std::vector<T> play(const std::vector<T>& stream, std::size_t play, Stamp stamp)
                         stream.begin() + static_cast<std::ptrdiff_t>(end));
 }
 
-// The estimator's frame queue (frame_queue_size 20 at 20 Hz): what a clock jump may cut.
-constexpr int64_t kOldRunTailNs = 1'000'000'000;
+// The estimator's frame queue (frame_queue_size, by default the synchroniser's) in time: what
+// a clock jump may cut.
+int64_t oldRunTailNs() {
+  return static_cast<int64_t>(static_cast<double>(alvio::FrameImuSyncOptions().max_frames) /
+                              g_settings.camera_rate_hz * 1e9);
+}
 
 const auto kStampOf = [](int64_t t) { return t; };
 const auto kOdometryStampOf = [](const std::pair<int64_t, alvio::StampedPose>& o) {
@@ -215,9 +220,9 @@ TEST(NodeletPipeline, OdometryAndTfArriveAtTheImageRateWithImageStamps) {
   const std::set<int64_t> image_stamps(images.begin(), images.end());
   // A looping player's clock jump ends the first play's run, and by design (frame_imu_sync.h)
   // drops the old run's frames still queued: the last image, whose IMU sample after it never
-  // comes, and on a loaded machine a backlog of up to the estimator's frame queue (1 s). So the
-  // first play's last second is not counted.
-  const int64_t counted_until = g_settings.replay ? images.back() - kOldRunTailNs : images.back();
+  // comes, and on a loaded machine a backlog of up to the estimator's frame queue (1 s at 20 Hz).
+  // So the first play's last frame-queue's worth is not counted.
+  const int64_t counted_until = g_settings.replay ? images.back() - oldRunTailNs() : images.back();
   const auto counted = [&](int64_t t) { return t >= first && t <= counted_until; };
   const auto after = static_cast<double>(std::count_if(images.begin(), images.end(), counted));
   const auto tf_after = static_cast<double>(std::count_if(tf.begin(), tf.end(), counted));
