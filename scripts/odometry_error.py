@@ -18,9 +18,9 @@ nodelet's odometry message:
 - angular rate: the first IMU sample after the frame less the estimated gyroscope bias (what
   the nodelet publishes), against the truth's rate.
 
-It prints each run's errors, then the sigmas fitted over all runs: velocity and angular rate
-and tilt the largest per-axis RMS, position and yaw the least-squares fit of
-e^2 = s0^2 + (k d)^2. With --config it also prints how often that configuration's model holds
+It prints each run's errors, then the sigmas fitted over all runs: the angular rate's RMS per
+axis (a gyroscope on a vibrating body is noisier on some axes), velocity and tilt the largest
+per-axis RMS, position and yaw the least-squares fit of e^2 = s0^2 + (k d)^2. With --config it also prints how often that configuration's model holds
 each error within 1 and 2 sigma (a Gaussian: 68 % and 95 %), to check sigmas on runs that
 did not set them.
 """
@@ -36,6 +36,8 @@ from imu_noise import quat_to_matrix, rotation_log
 
 KEYS = ("position_sigma_m", "position_drift", "tilt_sigma_deg", "yaw_sigma_deg",
         "yaw_drift_deg_per_m", "velocity_sigma_mps", "angular_rate_sigma_rps")
+# Sigmas of the body-frame twist: one number for all three axes or a list of three (x, y, z).
+PER_AXIS_KEYS = ("velocity_sigma_mps", "angular_rate_sigma_rps")
 
 # The columns read from each file (more may follow); imu_noise.py reads the same formats.
 TUM_COLUMNS = imu_noise.TUM_COLUMNS
@@ -132,7 +134,7 @@ def fit(all_errors):
         "tilt_sigma_deg": float(np.max(rms(e["tilt"]))),
         "yaw_sigma_deg": y0[0], "yaw_drift_deg_per_m": y0[1],
         "velocity_sigma_mps": float(np.max(rms(e["velocity"]))),
-        "angular_rate_sigma_rps": float(np.max(rms(e["rate"]))),
+        "angular_rate_sigma_rps": [float(x) for x in rms(e["rate"])],
     }, n
 
 
@@ -158,7 +160,21 @@ def load_model(path):
     missing = [k for k in KEYS if k not in section]
     if missing:
         fail(f"{path}: odometry_covariance.{missing[0]} is not set (give every key to check it)")
-    return {k: float(section[k]) for k in KEYS}
+    return {k: model_value(path, k, section[k]) for k in KEYS}
+
+
+def model_value(path, key, value):
+    """A sigma from the file: a number, or for the twist's keys a list of three per axis."""
+    per_axis = key in PER_AXIS_KEYS
+    try:
+        if per_axis and isinstance(value, list):
+            if len(value) != 3:
+                raise ValueError
+            return np.array([float(v) for v in value])
+        return float(value)
+    except (TypeError, ValueError):
+        wanted = "a number or a list of 3 numbers (x, y, z)" if per_axis else "a number"
+        fail(f"{path}: odometry_covariance.{key} must be {wanted}, got {value!r}")
 
 
 def coverage(model, errors):
@@ -199,7 +215,9 @@ def main():
     fitted, n = fit(all_errors)
     print(f"\nFitted over {len(all_errors)} run(s), {n} poses:\n\nodometry_covariance:")
     for k in KEYS:
-        print(f"  {k}: {fitted[k]:.4g}")
+        v = fitted[k]
+        print(f"  {k}: " + (f"[{', '.join(f'{x:.4g}' for x in v)}]" if isinstance(v, list)
+                            else f"{v:.4g}"))
     if args.config:
         model = load_model(args.config)
         pooled = {k: np.concatenate([r[k] for r in all_errors]) for k in all_errors[0]}

@@ -3,6 +3,7 @@
 proportion to the path, tilt, body-frame velocity and gyroscope noise), written as alvio run
 writes trajectory.tum and states.csv. The fitted sigmas must give those sizes back, and a
 model with them must hold about 68 % and 95 % of Gaussian errors within 1 and 2 sigma."""
+import json
 import os
 import subprocess
 import tempfile
@@ -22,7 +23,7 @@ POSITION_DRIFT = 0.002                # m per m travelled, on each axis
 YAW_DRIFT_DEG_PER_M = 0.004
 TILT_SIGMA_DEG = 0.15
 VELOCITY_SIGMA = 0.02                 # m/s, body frame, per axis
-GYRO_SIGMA = 0.003                    # rad/s per sample
+GYRO_SIGMA = np.array([0.002, 0.005, 0.003])  # rad/s per sample, per axis (as a vibrating body)
 
 
 def rot_z(a):
@@ -109,7 +110,7 @@ def fitted(stdout):
     for line in section.splitlines():
         if line.startswith("  ") and ":" in line:
             key, value = line.split(":")
-            values[key.strip()] = float(value)
+            values[key.strip()] = json.loads(value)  # a number or a per-axis list
     return values
 
 
@@ -143,9 +144,12 @@ class OdometryErrorTest(CleanFailureAssertions, unittest.TestCase):
         self.assertLess(got["yaw_sigma_deg"], 0.02)
         # Random errors: about 2000 poses, a few % of scatter.
         for key, want in (("tilt_sigma_deg", TILT_SIGMA_DEG),
-                          ("velocity_sigma_mps", VELOCITY_SIGMA),
-                          ("angular_rate_sigma_rps", GYRO_SIGMA)):
+                          ("velocity_sigma_mps", VELOCITY_SIGMA)):
             self.assertAlmostEqual(got[key], want, delta=0.1 * want, msg=key)
+        # The gyroscope's noise per axis.
+        self.assertEqual(len(got["angular_rate_sigma_rps"]), 3)
+        for axis, (value, want) in enumerate(zip(got["angular_rate_sigma_rps"], GYRO_SIGMA)):
+            self.assertAlmostEqual(value, want, delta=0.1 * want, msg=f"angular rate axis {axis}")
 
     def test_a_model_with_the_true_sigmas_holds_68_and_95_percent(self):
         config = Path(self.tmp.name) / "model.yaml"
@@ -154,7 +158,8 @@ class OdometryErrorTest(CleanFailureAssertions, unittest.TestCase):
             f"  position_sigma_m: 0.001\n  position_drift: {POSITION_DRIFT * 1.0001}\n"
             f"  tilt_sigma_deg: {TILT_SIGMA_DEG}\n  yaw_sigma_deg: 0.01\n"
             f"  yaw_drift_deg_per_m: {YAW_DRIFT_DEG_PER_M * 1.0001}\n"
-            f"  velocity_sigma_mps: {VELOCITY_SIGMA}\n  angular_rate_sigma_rps: {GYRO_SIGMA}\n")
+            f"  velocity_sigma_mps: {VELOCITY_SIGMA}\n"
+            f"  angular_rate_sigma_rps: {json.dumps(GYRO_SIGMA.tolist())}\n")
         p = run_script(f"{self.run_dir}:{self.data}", "--config", config)
         self.assertEqual(p.returncode, 0, p.stderr)
         rows = coverage(p.stdout)
@@ -174,6 +179,15 @@ class OdometryErrorTest(CleanFailureAssertions, unittest.TestCase):
         config.write_text("odometry_covariance:\n  position_drift: 0.001\n")
         self.assertFailsCleanly(run_script(f"{self.run_dir}:{self.data}", "--config", config),
                                 "odometry_covariance.position_sigma_m")
+        two_axes = Path(self.tmp.name) / "two_axes.yaml"
+        two_axes.write_text("odometry_covariance:\n" + "".join(
+            f"  {key}: 0.01\n" for key in ("position_sigma_m", "position_drift", "tilt_sigma_deg",
+                                           "yaw_sigma_deg", "yaw_drift_deg_per_m",
+                                           "velocity_sigma_mps"))
+            + "  angular_rate_sigma_rps: [0.01, 0.02]\n")
+        self.assertFailsCleanly(run_script(f"{self.run_dir}:{self.data}", "--config", two_axes),
+                                "odometry_covariance.angular_rate_sigma_rps must be a number or "
+                                "a list of 3 numbers (x, y, z), got [0.01, 0.02]")
 
     def test_a_short_file_names_its_missing_column(self):
         short = Path(self.tmp.name) / "short"

@@ -19,8 +19,8 @@ OdometryCovarianceOptions someOptions() {
   o.tilt_sigma_deg = 0.2;
   o.yaw_sigma_deg = 1.0;
   o.yaw_drift_deg_per_m = 0.01;
-  o.velocity_sigma_mps = 0.01;
-  o.angular_rate_sigma_rps = 0.0025;
+  o.velocity_sigma_mps = Eigen::Vector3d::Constant(0.01);
+  o.angular_rate_sigma_rps = Eigen::Vector3d(0.0025, 0.005, 0.004);
   return o;
 }
 
@@ -46,7 +46,7 @@ TEST(OdometryCovariance, PositionAndYawGrowWithThePathTiltAndTwistDoNot) {
   const double position = 0.03 * 0.03 + 0.2 * 0.2;  // 0.002 m/m over 100 m
   const double yaw = (1.0 + 1.0) * kDeg * kDeg;     // 0.01 deg/m over 100 m
   expectDiagonal(model.pose(), {position, position, position, tilt, tilt, yaw});
-  expectDiagonal(model.twist(), {1e-4, 1e-4, 1e-4, 6.25e-6, 6.25e-6, 6.25e-6});
+  expectDiagonal(model.twist(), {1e-4, 1e-4, 1e-4, 6.25e-6, 2.5e-5, 1.6e-5});
   // A new run starts its path again; a non-finite position is not a step.
   model.reset();
   model.addPosition(Eigen::Vector3d(50, 0, 0));
@@ -60,7 +60,7 @@ TEST(OdometryCovariance, ReadsItsSectionAndNamesABadKey) {
       "odometry_covariance:\n  position_drift: 0.004\n  velocity_sigma_mps: 0.05\n", "robot.yaml");
   const OdometryCovarianceOptions o = OdometryCovarianceOptions::load(yaml, "odometry_covariance");
   EXPECT_DOUBLE_EQ(o.position_drift, 0.004);
-  EXPECT_DOUBLE_EQ(o.velocity_sigma_mps, 0.05);
+  EXPECT_EQ(o.velocity_sigma_mps, Eigen::Vector3d::Constant(0.05));  // one number: all axes
   EXPECT_DOUBLE_EQ(o.tilt_sigma_deg, OdometryCovarianceOptions().tilt_sigma_deg);
   for (const char* key : {"position_sigma_m", "yaw_drift_deg_per_m", "angular_rate_sigma_rps"}) {
     const YamlReader bad = YamlReader::fromString(
@@ -72,13 +72,42 @@ TEST(OdometryCovariance, ReadsItsSectionAndNamesABadKey) {
   }
 }
 
+TEST(OdometryCovariance, TheTwistsSigmasMayDifferPerAxis) {
+  const YamlReader yaml = YamlReader::fromString(
+      "odometry_covariance:\n  angular_rate_sigma_rps: [0.018, 0.05, 0.03]\n", "robot.yaml");
+  OdometryCovarianceOptions o = OdometryCovarianceOptions::load(yaml, "odometry_covariance");
+  EXPECT_EQ(o.angular_rate_sigma_rps, Eigen::Vector3d(0.018, 0.05, 0.03));
+  EXPECT_EQ(o.velocity_sigma_mps, OdometryCovarianceOptions().velocity_sigma_mps);
+  o.velocity_sigma_mps = Eigen::Vector3d(0.01, 0.02, 0.03);
+  expectDiagonal(OdometryCovariance(o).twist(), {1e-4, 4e-4, 9e-4, 0.018 * 0.018, 0.0025, 9e-4});
+
+  const std::pair<const char*, const char*> bad[] = {
+      {"[0.018, 0.05]",
+       "robot.yaml: key 'odometry_covariance.angular_rate_sigma_rps' must have 3 values"},
+      {"[0.018, -0.05, 0.03]",
+       "robot.yaml: odometry_covariance.angular_rate_sigma_rps must be a "
+       "finite value >= 0, got -0.05"},
+      {"{x: 1}",
+       "robot.yaml: key 'odometry_covariance.angular_rate_sigma_rps' must be a number or a list of "
+       "3 numbers (x, y, z)"},
+      {"[0.018, fast, 0.03]", "odometry_covariance.angular_rate_sigma_rps[1]"}};
+  for (const auto& [value, message] : bad) {
+    const YamlReader y = YamlReader::fromString(
+        std::string("odometry_covariance:\n  angular_rate_sigma_rps: ") + value + "\n",
+        "robot.yaml");
+    const std::string error =
+        test::errorOf([&] { OdometryCovarianceOptions::load(y, "odometry_covariance"); });
+    EXPECT_NE(error.find(message), std::string::npos) << value << ": " << error;
+  }
+}
+
 TEST(OdometryCovariance, ShippedConfigsGiveTheRealImuWiderSigmas) {
   const Config euroc = Config::load(test::sourcePath("config/euroc.yaml"));
   const Config real = Config::load(test::sourcePath("config/euroc_real.yaml"));
   const OdometryCovarianceOptions& s = euroc.odometry_covariance;
   const OdometryCovarianceOptions& r = real.odometry_covariance;
-  EXPECT_GT(r.velocity_sigma_mps, s.velocity_sigma_mps);
-  EXPECT_GT(r.angular_rate_sigma_rps, s.angular_rate_sigma_rps);
+  EXPECT_GT(r.velocity_sigma_mps.minCoeff(), s.velocity_sigma_mps.maxCoeff());
+  EXPECT_GT(r.angular_rate_sigma_rps.minCoeff(), s.angular_rate_sigma_rps.maxCoeff());
   EXPECT_GE(r.position_drift, s.position_drift);
   EXPECT_GT(s.position_sigma_m, 0.0);
   EXPECT_GT(s.yaw_sigma_deg, 0.0);

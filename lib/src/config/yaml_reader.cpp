@@ -168,6 +168,18 @@ std::vector<double> YamlReader::getDoubles(const std::string& key,
   if (!find(key)) return fallback;
   return getDoubles(key);
 }
+Eigen::Vector3d YamlReader::getPerAxis(const std::string& key,
+                                       const Eigen::Vector3d& fallback) const {
+  const std::optional<YAML::Node> node = find(key);
+  if (!node) return fallback;
+  if (node->IsSequence()) {
+    const std::vector<double> v = getDoubles(key, 3);
+    return {v[0], v[1], v[2]};
+  }
+  if (!node->IsScalar())
+    throw Error(where(key) + " must be a number or a list of 3 numbers (x, y, z)");
+  return Eigen::Vector3d::Constant(convertDouble(*node, where(key)));
+}
 std::string YamlReader::getChoice(const std::string& key, const std::string& fallback,
                                   const std::vector<std::string>& choices) const {
   const std::string value = getString(key, fallback);

@@ -27,8 +27,9 @@ OdometryCovarianceOptions OdometryCovarianceOptions::load(const YamlReader& yaml
   o.tilt_sigma_deg = yaml.getDouble(p + "tilt_sigma_deg", o.tilt_sigma_deg);
   o.yaw_sigma_deg = yaml.getDouble(p + "yaw_sigma_deg", o.yaw_sigma_deg);
   o.yaw_drift_deg_per_m = yaml.getDouble(p + "yaw_drift_deg_per_m", o.yaw_drift_deg_per_m);
-  o.velocity_sigma_mps = yaml.getDouble(p + "velocity_sigma_mps", o.velocity_sigma_mps);
-  o.angular_rate_sigma_rps = yaml.getDouble(p + "angular_rate_sigma_rps", o.angular_rate_sigma_rps);
+  o.velocity_sigma_mps = yaml.getPerAxis(p + "velocity_sigma_mps", o.velocity_sigma_mps);
+  o.angular_rate_sigma_rps =
+      yaml.getPerAxis(p + "angular_rate_sigma_rps", o.angular_rate_sigma_rps);
   o.validate(yaml.path() + ": " + prefix);
   return o;
 }
@@ -40,8 +41,12 @@ void OdometryCovarianceOptions::validate(const std::string& where) const {
       {"tilt_sigma_deg", tilt_sigma_deg},
       {"yaw_sigma_deg", yaw_sigma_deg},
       {"yaw_drift_deg_per_m", yaw_drift_deg_per_m},
-      {"velocity_sigma_mps", velocity_sigma_mps},
-      {"angular_rate_sigma_rps", angular_rate_sigma_rps}};
+      {"velocity_sigma_mps", velocity_sigma_mps.x()},
+      {"velocity_sigma_mps", velocity_sigma_mps.y()},
+      {"velocity_sigma_mps", velocity_sigma_mps.z()},
+      {"angular_rate_sigma_rps", angular_rate_sigma_rps.x()},
+      {"angular_rate_sigma_rps", angular_rate_sigma_rps.y()},
+      {"angular_rate_sigma_rps", angular_rate_sigma_rps.z()}};
   for (const auto& [key, value] : values) {
     if (std::isfinite(value) && value >= 0) continue;
     std::ostringstream os;
@@ -71,8 +76,9 @@ Covariance6 OdometryCovariance::pose() const {
 }
 
 Covariance6 OdometryCovariance::twist() const {
-  const double v = options_.velocity_sigma_mps, w = options_.angular_rate_sigma_rps;
-  return diagonal({v, v, v, w, w, w});
+  const Eigen::Vector3d& v = options_.velocity_sigma_mps;
+  const Eigen::Vector3d& w = options_.angular_rate_sigma_rps;
+  return diagonal({v.x(), v.y(), v.z(), w.x(), w.y(), w.z()});
 }
 
 }  // namespace alvio

@@ -45,6 +45,8 @@ class YamlReader {
   bool getBool(const std::string& key, bool fallback) const;
   std::string getString(const std::string& key, const std::string& fallback) const;
   std::vector<double> getDoubles(const std::string& key, const std::vector<double>& fallback) const;
+  /// Per-axis values (x, y, z): one number for all three, or a list of three.
+  Eigen::Vector3d getPerAxis(const std::string& key, const Eigen::Vector3d& fallback) const;
   /// One word out of `choices`; anything else throws "<where> must be a, b or c, not 'x'".
   std::string getChoice(const std::string& key, const std::string& fallback,
                         const std::vector<std::string>& choices) const;

@@ -24,8 +24,10 @@ struct OdometryCovarianceOptions {
   /// Yaw, 1 sigma: sqrt(yaw_sigma_deg^2 + (yaw_drift_deg_per_m * path)^2).
   double yaw_sigma_deg = 0.067;
   double yaw_drift_deg_per_m = 0.0023;
-  double velocity_sigma_mps = 0.006;       ///< linear velocity in the body frame, per axis
-  double angular_rate_sigma_rps = 0.0025;  ///< angular rate in the body frame, per axis
+  // Body frame, per axis (x, y, z); in the file one number for all three or a list of three.
+  // A gyroscope on a vibrating body is noisier on some axes (EuRoC's y: 2.7x its x).
+  Eigen::Vector3d velocity_sigma_mps = Eigen::Vector3d::Constant(0.006);       ///< linear velocity
+  Eigen::Vector3d angular_rate_sigma_rps = Eigen::Vector3d::Constant(0.0025);  ///< angular rate
 
   /// Reads the keys under `prefix` ("odometry_covariance"); every key is optional. Throws
   /// alvio::Error naming the key on a bad value.
