@@ -190,6 +190,10 @@ def coverage(model, errors):
         "velocity": np.abs(errors["velocity"]) / model["velocity_sigma_mps"],
         "angular rate": np.abs(errors["rate"]) / model["angular_rate_sigma_rps"],
     }
+    # The twist per axis too: which axis a single sigma misfits, or a per-axis one still does.
+    for name in ("velocity", "angular rate"):
+        for axis, label in enumerate("xyz"):
+            parts[f"{name} {label}"] = parts[name][:, axis]
     return {name: (float(np.mean(z <= 1)), float(np.mean(z <= 2))) for name, z in parts.items()}
 
 

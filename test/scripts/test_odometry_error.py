@@ -163,7 +163,8 @@ class OdometryErrorTest(CleanFailureAssertions, unittest.TestCase):
         p = run_script(f"{self.run_dir}:{self.data}", "--config", config)
         self.assertEqual(p.returncode, 0, p.stderr)
         rows = coverage(p.stdout)
-        for name in ("tilt", "velocity", "angular rate"):
+        for name in ("tilt", "velocity", "angular rate", "angular rate x", "angular rate y",
+                     "angular rate z", "velocity z"):
             one, two = rows[name]
             self.assertAlmostEqual(one, 68.3, delta=4, msg=name)
             self.assertAlmostEqual(two, 95.4, delta=2, msg=name)
@@ -171,6 +172,21 @@ class OdometryErrorTest(CleanFailureAssertions, unittest.TestCase):
         # the second-order part of the tilt's noise in the yaw and the alignment.
         for name in ("position", "yaw"):
             self.assertGreater(rows[name][0], 98.0, name)
+
+    def test_one_sigma_for_all_axes_shows_which_axis_it_misfits(self):
+        config = Path(self.tmp.name) / "one_sigma.yaml"
+        config.write_text(
+            "odometry_covariance:\n" + "".join(
+                f"  {key}: 0.01\n" for key in ("position_sigma_m", "position_drift",
+                                               "tilt_sigma_deg", "yaw_sigma_deg",
+                                               "yaw_drift_deg_per_m", "velocity_sigma_mps"))
+            + f"  angular_rate_sigma_rps: {GYRO_SIGMA.max()}\n")
+        p = run_script(f"{self.run_dir}:{self.data}", "--config", config)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        rows = coverage(p.stdout)
+        # The largest axis's sigma fits y (5 mrad/s) and holds x (2 mrad/s) far too often.
+        self.assertAlmostEqual(rows["angular rate y"][0], 68.3, delta=4)
+        self.assertGreater(rows["angular rate x"][0], 98.0)
 
     def test_bad_input_is_named(self):
         self.assertFailsCleanly(run_script(f"{self.run_dir}"), "RUN:DATASET")
