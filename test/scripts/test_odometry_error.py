@@ -6,6 +6,7 @@ model with them must hold about 68 % and 95 % of Gaussian errors within 1 and 2 
 import json
 import os
 import subprocess
+import sys
 import tempfile
 import unittest
 from pathlib import Path
@@ -16,6 +17,8 @@ from rotations import quaternion_xyzw  # test/scripts/, on the path
 from script_failures import CleanFailureAssertions
 
 SCRIPT = Path(__file__).resolve().parents[2] / "scripts" / "odometry_error.py"
+sys.path.insert(0, str(SCRIPT.parent))
+from odometry_error import KEYS  # noqa: E402  (the section's keys, as the script reads them)
 RATE_HZ, CAMERA_EVERY = 200, 10
 DURATION_S = 200.0
 SPEED, RADIUS = 1.0, 5.0              # m/s, m: a 200 m path
@@ -173,14 +176,16 @@ class OdometryErrorTest(CleanFailureAssertions, unittest.TestCase):
         for name in ("position", "yaw"):
             self.assertGreater(rows[name][0], 98.0, name)
 
+    def model_with_angular_rate(self, name, angular_rate):
+        """A complete odometry_covariance section: 0.01 for every key but the angular rate."""
+        config = Path(self.tmp.name) / name
+        config.write_text("odometry_covariance:\n" + "".join(
+            f"  {key}: 0.01\n" for key in KEYS if key != "angular_rate_sigma_rps")
+            + f"  angular_rate_sigma_rps: {angular_rate}\n")
+        return config
+
     def test_one_sigma_for_all_axes_shows_which_axis_it_misfits(self):
-        config = Path(self.tmp.name) / "one_sigma.yaml"
-        config.write_text(
-            "odometry_covariance:\n" + "".join(
-                f"  {key}: 0.01\n" for key in ("position_sigma_m", "position_drift",
-                                               "tilt_sigma_deg", "yaw_sigma_deg",
-                                               "yaw_drift_deg_per_m", "velocity_sigma_mps"))
-            + f"  angular_rate_sigma_rps: {GYRO_SIGMA.max()}\n")
+        config = self.model_with_angular_rate("one_sigma.yaml", GYRO_SIGMA.max())
         p = run_script(f"{self.run_dir}:{self.data}", "--config", config)
         self.assertEqual(p.returncode, 0, p.stderr)
         rows = coverage(p.stdout)
@@ -195,12 +200,7 @@ class OdometryErrorTest(CleanFailureAssertions, unittest.TestCase):
         config.write_text("odometry_covariance:\n  position_drift: 0.001\n")
         self.assertFailsCleanly(run_script(f"{self.run_dir}:{self.data}", "--config", config),
                                 "odometry_covariance.position_sigma_m")
-        two_axes = Path(self.tmp.name) / "two_axes.yaml"
-        two_axes.write_text("odometry_covariance:\n" + "".join(
-            f"  {key}: 0.01\n" for key in ("position_sigma_m", "position_drift", "tilt_sigma_deg",
-                                           "yaw_sigma_deg", "yaw_drift_deg_per_m",
-                                           "velocity_sigma_mps"))
-            + "  angular_rate_sigma_rps: [0.01, 0.02]\n")
+        two_axes = self.model_with_angular_rate("two_axes.yaml", "[0.01, 0.02]")
         self.assertFailsCleanly(run_script(f"{self.run_dir}:{self.data}", "--config", two_axes),
                                 "odometry_covariance.angular_rate_sigma_rps must be a number or "
                                 "a list of 3 numbers (x, y, z), got [0.01, 0.02]")
