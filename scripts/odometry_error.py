@@ -4,15 +4,16 @@
 
     scripts/odometry_error.py RUN:DATASET [RUN:DATASET ...] [--config YAML]
 
-RUN is an `alvio run --out` folder (trajectory.tum, states.csv); DATASET the EuRoC/ASL folder
-it ran on, with mav0/state_groundtruth_estimate0/data.csv (position, orientation, velocity)
-and mav0/imu0/data.csv. For every output pose the errors are those of the estimator
-nodelet's odometry message:
+RUN is an `alvio run --out` folder (trajectory.tum, states.csv, events.log); DATASET the
+EuRoC/ASL folder it ran on, with mav0/state_groundtruth_estimate0/data.csv (position,
+orientation, velocity) and mav0/imu0/data.csv. For every output pose the errors are those of
+the estimator nodelet's odometry message:
 
 - position and yaw relative to where the odometry started: both trajectories are put on the
   first output pose (position and yaw; roll and pitch are gravity's), so the error is the
   drift since then, against the path travelled (the truth's; the nodelet counts its own
-  output's, which differs by the scale error, a few per cent);
+  output's, which differs by the scale error, a few per cent) and the estimator's resets so
+  far (events.log): after each, the output goes on from the IMU's dead reckoning;
 - tilt: the orientation's error about the world's x and y axes (gravity's direction);
 - velocity in the body frame (R^T v), which no alignment changes;
 - angular rate: the first IMU sample after the frame less the estimated gyroscope bias (what
@@ -20,8 +21,9 @@ nodelet's odometry message:
 
 It prints each run's errors, then the sigmas fitted over all runs: the angular rate's RMS per
 axis (a gyroscope on a vibrating body is noisier on some axes), velocity and tilt the largest
-per-axis RMS, position and yaw the least-squares fit of e^2 = s0^2 + (k d)^2. With --config it
-also prints how often that configuration's model holds each error within 1 and 2 sigma (a
+per-axis RMS, position and yaw the least-squares fit of e^2 = s0^2 + (k d)^2 + n r^2 (d the
+path, n the resets before the pose; r is fitted only when the runs have a reset). With
+--config it also prints how often that configuration's model holds each error within 1 and 2 sigma (a
 Gaussian: 68 % and 95 %), to check sigmas on runs that did not set them.
 """
 import argparse
@@ -35,7 +37,9 @@ import imu_noise  # scripts/, beside this one
 from imu_noise import quat_to_matrix, rotation_log
 
 KEYS = ("position_sigma_m", "position_drift", "tilt_sigma_deg", "yaw_sigma_deg",
-        "yaw_drift_deg_per_m", "velocity_sigma_mps", "angular_rate_sigma_rps")
+        "yaw_drift_deg_per_m", "reset_position_sigma_m", "reset_yaw_sigma_deg",
+        "velocity_sigma_mps", "angular_rate_sigma_rps")
+RESET_KEYS = ("reset_position_sigma_m", "reset_yaw_sigma_deg")
 # Sigmas of the body-frame twist: one number for all three axes or a list of three (x, y, z).
 PER_AXIS_KEYS = ("velocity_sigma_mps", "angular_rate_sigma_rps")
 
@@ -73,6 +77,7 @@ def run_errors(run, dataset):
     imu = load_table(dataset / "mav0/imu0/data.csv", IMU_COLUMNS, delimiter=",")
     if len(states) != len(est) or np.max(np.abs(states[:, 0] - est[:, 0])) > 1e-4:
         fail(f"{run}: states.csv and trajectory.tum do not have the same poses")
+    reset_times = load_reset_times(run / "events.log")
     t_gt, t_imu = gt[:, 0] * 1e-9, imu[:, 0] * 1e-9
     inside = (est[:, 0] > t_gt[0] + 0.01) & (est[:, 0] < t_gt[-1] - 0.01)
     if inside.sum() < 2:
@@ -97,6 +102,7 @@ def run_errors(run, dataset):
     p_est = (est[:, 1:4] - est[0, 1:4]) @ Rz.T + p_gt[0]
     rot_err = np.degrees(rotation_log(np.einsum("ij,njk,nlk->nil", Rz, R_est, R_gt)))
     path = np.concatenate([[0], np.cumsum(np.linalg.norm(np.diff(p_gt, axis=0), axis=1))])
+    resets = np.searchsorted(reset_times, t, side="right")  # resets at or before each pose
     # Angular rate: the first IMU sample after the frame (the last the nodelet is given with
     # it), less the estimated bias.
     j = np.clip(np.searchsorted(t_imu, t, side="right"), 0, len(t_imu) - 1)
@@ -105,34 +111,62 @@ def run_errors(run, dataset):
     Rm = quat_to_matrix(interpolate_quaternions(np.clip(t - h, t_gt[0], t_gt[-1]), t_gt, q_gt_all))
     rate_gt = rotation_log(np.einsum("nji,njk->nik", Rm, Rp)) / (2 * h)
     rate_err = imu[j, 1:4] - states[:, 7:10] - rate_gt
-    return {"path": path, "position": p_est - p_gt, "yaw": rot_err[:, 2], "tilt": rot_err[:, :2],
-            "velocity": v_body - v_body_gt, "rate": rate_err}
+    return {"path": path, "resets": resets, "position": p_est - p_gt, "yaw": rot_err[:, 2],
+            "tilt": rot_err[:, :2], "velocity": v_body - v_body_gt, "rate": rate_err}
+
+
+def load_reset_times(path):
+    """The times of the estimator's resets: events.log's lines "<t> reset <why>"."""
+    try:
+        lines = Path(path).read_text().splitlines()
+    except OSError as e:
+        fail(f"{path}: cannot read: {e} (alvio run writes it beside trajectory.tum)")
+    times = []
+    for number, line in enumerate(lines, 1):
+        fields = line.split(maxsplit=2)
+        if len(fields) >= 2 and fields[1] == "reset":
+            try:
+                times.append(float(fields[0]))
+            except ValueError:
+                fail(f"{path}:{number}: a reset without a time: {line!r}")
+    return np.sort(np.array(times))
 
 
 def rms(x, axis=0):
     return np.sqrt(np.mean(np.square(x), axis=axis))
 
 
-def fit_growth(errors_sq, path):
-    """s0, k of e^2 = s0^2 + (k d)^2 by least squares on the squares, both >= 0."""
-    A = np.stack([np.ones_like(path), path ** 2], 1)
-    coef, *_ = np.linalg.lstsq(A, errors_sq, rcond=None)
-    if coef[1] < 0:
-        return float(np.sqrt(np.mean(errors_sq))), 0.0
-    if coef[0] < 0:
-        return 0.0, float(np.sqrt(np.sum(errors_sq * path ** 2) / np.sum(path ** 4)))
-    return float(np.sqrt(coef[0])), float(np.sqrt(coef[1]))
+def fit_growth(errors_sq, path, resets):
+    """s0, k, r of e^2 = s0^2 + (k d)^2 + n r^2 by least squares on the squares, all >= 0.
+
+    With three unknowns the constrained optimum is the best unconstrained fit, over the
+    subsets of the terms, whose coefficients are all >= 0."""
+    A = np.stack([np.ones_like(path), path ** 2, resets.astype(float)], 1)
+    best = None
+    for subset in range(1, 8):
+        cols = [j for j in range(3) if subset >> j & 1]
+        coef, *_ = np.linalg.lstsq(A[:, cols], errors_sq, rcond=None)
+        if np.any(coef < 0):
+            continue
+        full = np.zeros(3)
+        full[cols] = coef
+        residual = np.sum(np.square(A @ full - errors_sq))
+        if best is None or residual < best[0]:
+            best = (residual, full)
+    return tuple(float(np.sqrt(c)) for c in best[1])
 
 
 def fit(all_errors):
     e = {k: np.concatenate([r[k] for r in all_errors]) for k in all_errors[0]}
     n = len(e["path"])
-    s0 = fit_growth(np.square(e["position"]).reshape(-1), np.repeat(e["path"], 3))
-    y0 = fit_growth(np.square(e["yaw"]), e["path"])
+    s0 = fit_growth(np.square(e["position"]).reshape(-1), np.repeat(e["path"], 3),
+                    np.repeat(e["resets"], 3))
+    y0 = fit_growth(np.square(e["yaw"]), e["path"], e["resets"])
     return {
         "position_sigma_m": s0[0], "position_drift": s0[1],
         "tilt_sigma_deg": float(np.max(rms(e["tilt"]))),
         "yaw_sigma_deg": y0[0], "yaw_drift_deg_per_m": y0[1],
+        "reset_position_sigma_m": s0[2], "reset_yaw_sigma_deg": y0[2],
         "velocity_sigma_mps": float(np.max(rms(e["velocity"]))),
         "angular_rate_sigma_rps": [float(x) for x in rms(e["rate"])],
     }, n
@@ -157,6 +191,8 @@ def load_model(path):
     unknown = sorted(set(section) - set(KEYS))
     if unknown:
         fail(f"{path}: unknown key odometry_covariance.{unknown[0]}")
+    # A configuration from before the reset keys widens nothing after a reset, as in alvio.
+    section = {**{k: 0.0 for k in RESET_KEYS}, **section}
     missing = [k for k in KEYS if k not in section]
     if missing:
         fail(f"{path}: odometry_covariance.{missing[0]} is not set (give every key to check it)")
@@ -179,9 +215,11 @@ def model_value(path, key, value):
 
 def coverage(model, errors):
     """Fraction of each component's errors within 1 and 2 of the model's sigmas."""
-    d = errors["path"]
-    sp = np.hypot(model["position_sigma_m"], model["position_drift"] * d)
-    sy = np.hypot(model["yaw_sigma_deg"], model["yaw_drift_deg_per_m"] * d)
+    d, n = errors["path"], errors["resets"]
+    sp = np.sqrt(model["position_sigma_m"] ** 2 + (model["position_drift"] * d) ** 2 +
+                 n * model["reset_position_sigma_m"] ** 2)
+    sy = np.sqrt(model["yaw_sigma_deg"] ** 2 + (model["yaw_drift_deg_per_m"] * d) ** 2 +
+                 n * model["reset_yaw_sigma_deg"] ** 2)
     # Normalised errors, one per axis and pose.
     parts = {
         "position": np.abs(errors["position"]) / sp[:, None],
@@ -190,6 +228,10 @@ def coverage(model, errors):
         "velocity": np.abs(errors["velocity"]) / model["velocity_sigma_mps"],
         "angular rate": np.abs(errors["rate"]) / model["angular_rate_sigma_rps"],
     }
+    # The poses after a reset on their own: the few that the reset sigmas are for.
+    if np.any(n > 0):
+        parts["position after a reset"] = parts["position"][n > 0]
+        parts["yaw after a reset"] = parts["yaw"][n > 0]
     # The twist per axis too: which axis a single sigma misfits, or a per-axis one still does.
     for name in ("velocity", "angular rate"):
         for axis, label in enumerate("xyz"):
@@ -203,25 +245,32 @@ def main():
     ap.add_argument("--config", help="check this configuration's odometry_covariance sigmas")
     args = ap.parse_args()
     all_errors = []
-    print("| run | poses | path (m) | position at the end (m) | yaw RMS (deg) | tilt RMS, larger axis (deg) | "
-          "velocity RMS x/y/z (m/s) | angular rate RMS x/y/z (rad/s) |")
-    print("|---|---|---|---|---|---|---|---|")
+    print("| run | poses | path (m) | resets | position at the end (m) | yaw RMS (deg) | "
+          "tilt RMS, larger axis (deg) | velocity RMS x/y/z (m/s) | "
+          "angular rate RMS x/y/z (rad/s) |")
+    print("|---|---|---|---|---|---|---|---|---|")
     for spec in args.runs:
         if ":" not in spec:
             fail(f"'{spec}' is not RUN:DATASET")
         run, dataset = spec.split(":", 1)
         e = run_errors(run, dataset)
         all_errors.append(e)
-        print(f"| {run} | {len(e['path'])} | {e['path'][-1]:.1f} | "
+        print(f"| {run} | {len(e['path'])} | {e['path'][-1]:.1f} | {e['resets'][-1]} | "
               f"{np.linalg.norm(e['position'][-1]):.3f} | {rms(e['yaw']):.3f} | "
               f"{np.max(rms(e['tilt'])):.3f} | {' / '.join(f'{x:.4f}' for x in rms(e['velocity']))} | "
               f"{' / '.join(f'{x:.4f}' for x in rms(e['rate']))} |")
     fitted, n = fit(all_errors)
     print(f"\nFitted over {len(all_errors)} run(s), {n} poses:\n\nodometry_covariance:")
+    any_reset = any(e["resets"][-1] > 0 for e in all_errors)
     for k in KEYS:
+        if k in RESET_KEYS and not any_reset:
+            continue  # nothing to fit them on: noted below
         v = fitted[k]
         print(f"  {k}: " + (f"[{', '.join(f'{x:.4g}' for x in v)}]" if isinstance(v, list)
                             else f"{v:.4g}"))
+    if not any_reset:
+        print(f"\n{' and '.join(RESET_KEYS)}: not fitted, as no run has a reset of the estimator "
+              "(keep your configuration's)")
     if args.config:
         model = load_model(args.config)
         pooled = {k: np.concatenate([r[k] for r in all_errors]) for k in all_errors[0]}

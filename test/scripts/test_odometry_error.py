@@ -1,8 +1,10 @@
 """Tests of scripts/odometry_error.py on a synthetic run: a tilted body flying a circle, an
 "estimate" made from the truth with errors of known size (position and yaw drifting in
 proportion to the path, tilt, body-frame velocity and gyroscope noise), written as alvio run
-writes trajectory.tum and states.csv. The fitted sigmas must give those sizes back, and a
-model with them must hold about 68 % and 95 % of Gaussian errors within 1 and 2 sigma."""
+writes trajectory.tum, states.csv and events.log. The fitted sigmas must give those sizes back,
+and a model with them must hold about 68 % and 95 % of Gaussian errors within 1 and 2 sigma.
+A second run has resets of the estimator, each of which adds a known variance to position and
+yaw."""
 import json
 import os
 import subprocess
@@ -27,6 +29,9 @@ YAW_DRIFT_DEG_PER_M = 0.004
 TILT_SIGMA_DEG = 0.15
 VELOCITY_SIGMA = 0.02                 # m/s, body frame, per axis
 GYRO_SIGMA = np.array([0.002, 0.005, 0.003])  # rad/s per sample, per axis (as a vibrating body)
+RESET_TIMES_S = (40.0, 90.0, 150.0)   # after the start, in the run with resets
+RESET_POSITION_SIGMA = 0.05           # m per axis, added in quadrature per reset
+RESET_YAW_SIGMA_DEG = 0.3
 
 
 def rot_z(a):
@@ -47,7 +52,8 @@ def small_rotation(v):
     return np.eye(3) + np.sin(a) * K + (1 - np.cos(a)) * (K @ K)
 
 
-def make_run(folder, seed):
+def make_run(folder, seed, resets=()):
+    """A run in folder/run on the dataset folder/data; resets: their times after the start."""
     rng = np.random.default_rng(seed)
     n = int(DURATION_S * RATE_HZ) + 1
     t_ns = 1_600_000_000_000_000_000 + np.arange(n, dtype=np.int64) * (10**9 // RATE_HZ)
@@ -76,15 +82,20 @@ def make_run(folder, seed):
     tc = t[k] - 0.001
     stamps = t_ns[k] * 1e-9 - 0.001
     path = SPEED * (tc - tc[0])
+    # Position and yaw errors of exactly the model's size, sqrt((k d)^2 + n r^2): the fit is
+    # least squares, so it must give k and r back to the second-order effects of the noise.
+    n_resets = np.searchsorted(t[0] + np.array(resets), tc, side="right")
+    position_error = np.sqrt((POSITION_DRIFT * path) ** 2 + n_resets * RESET_POSITION_SIGMA ** 2)
+    yaw_error = np.sqrt((YAW_DRIFT_DEG_PER_M * path) ** 2 + n_resets * RESET_YAW_SIGMA_DEG ** 2)
     # The estimate's own frame: a yaw and an offset the script must take out at its start.
     frame_yaw, frame_offset = 0.7, np.array([3.0, -2.0, 0.5])
     pk = np.stack([RADIUS * np.cos(w * tc), RADIUS * np.sin(w * tc), 0.2 * np.sin(0.3 * tc)], 1)
     vk = np.stack([-SPEED * np.sin(w * tc), SPEED * np.cos(w * tc), 0.06 * np.cos(0.3 * tc)], 1)
     Rk = rot_z(w * tc + 1.0) @ tilt
     err_rot = np.column_stack([rng.normal(0, np.radians(TILT_SIGMA_DEG), (len(k), 2)),
-                               np.radians(YAW_DRIFT_DEG_PER_M) * path])
+                               np.radians(yaw_error)])
     R_est = small_rotation(err_rot) @ Rk
-    p_est = pk + POSITION_DRIFT * path[:, None] * np.array([1.0, -1.0, 1.0])
+    p_est = pk + position_error[:, None] * np.array([1.0, -1.0, 1.0])
     # The velocity's error in the estimate's own body frame, as the script measures it.
     v_body = np.einsum("nji,nj->ni", Rk, vk) + rng.normal(0, VELOCITY_SIGMA, (len(k), 3))
     v_est = np.einsum("nij,nj->ni", R_est, v_body)
@@ -99,6 +110,11 @@ def make_run(folder, seed):
     np.savetxt(run / "states.csv", np.column_stack([stamps, v_est @ F.T, np.zeros((len(k), 3)), bias]),
                delimiter=",", fmt="%.9f", header="t,vx,vy,vz,bax,bay,baz,bgx,bgy,bgz",
                comments="")
+    # As the offline runner logs them: "<t> <kind> <message>".
+    start = t_ns[0] * 1e-9
+    events = [f"{stamps[0]:.6f} initialized estimator ready\n"] + [
+        f"{start + r:.6f} reset tracking lost: too few features\n" for r in resets]
+    (run / "events.log").write_text("".join(events))
     return run, folder / "data"
 
 
@@ -131,6 +147,8 @@ class OdometryErrorTest(CleanFailureAssertions, unittest.TestCase):
     def setUpClass(cls):
         cls.tmp = tempfile.TemporaryDirectory()
         cls.run_dir, cls.data = make_run(Path(cls.tmp.name), seed=3)
+        cls.reset_run, cls.reset_data = make_run(Path(cls.tmp.name) / "resets", seed=4,
+                                                 resets=RESET_TIMES_S)
 
     @classmethod
     def tearDownClass(cls):
@@ -153,16 +171,58 @@ class OdometryErrorTest(CleanFailureAssertions, unittest.TestCase):
         self.assertEqual(len(got["angular_rate_sigma_rps"]), 3)
         for axis, (value, want) in enumerate(zip(got["angular_rate_sigma_rps"], GYRO_SIGMA)):
             self.assertAlmostEqual(value, want, delta=0.1 * want, msg=f"angular rate axis {axis}")
+        # No reset to fit the reset sigmas on: they are left out, and the output says why.
+        self.assertNotIn("reset_position_sigma_m", got)
+        self.assertIn("reset_position_sigma_m and reset_yaw_sigma_deg: not fitted, as no run "
+                      "has a reset", p.stdout)
 
-    def test_a_model_with_the_true_sigmas_holds_68_and_95_percent(self):
-        config = Path(self.tmp.name) / "model.yaml"
+    def test_each_reset_adds_its_sigma_and_the_fit_gives_it_back(self):
+        p = run_script(f"{self.reset_run}:{self.reset_data}", f"{self.run_dir}:{self.data}")
+        self.assertEqual(p.returncode, 0, p.stderr)
+        self.assertIn(f"| {self.reset_run} | ", p.stdout)
+        self.assertIn(f" | {len(RESET_TIMES_S)} | ", p.stdout.split(str(self.reset_run), 1)[1])
+        got = fitted(p.stdout)
+        self.assertAlmostEqual(got["reset_position_sigma_m"], RESET_POSITION_SIGMA,
+                               delta=0.05 * RESET_POSITION_SIGMA)
+        self.assertAlmostEqual(got["reset_yaw_sigma_deg"], RESET_YAW_SIGMA_DEG,
+                               delta=0.05 * RESET_YAW_SIGMA_DEG)
+        # The path's drift is still the path's, not taken by the resets.
+        self.assertAlmostEqual(got["position_drift"], POSITION_DRIFT, delta=0.05 * POSITION_DRIFT)
+        self.assertAlmostEqual(got["yaw_drift_deg_per_m"], YAW_DRIFT_DEG_PER_M,
+                               delta=0.05 * YAW_DRIFT_DEG_PER_M)
+
+    def test_a_model_without_reset_sigmas_misses_the_poses_after_a_reset(self):
+        rows = {}
+        # Without: a configuration from before the reset keys, read as no widening.
+        for name, scale in (("with", 1.0001), ("without", None)):
+            config = self.true_model(f"{name}_resets.yaml", reset_scale=scale)
+            p = run_script(f"{self.reset_run}:{self.reset_data}", "--config", config)
+            self.assertEqual(p.returncode, 0, p.stderr)
+            rows[name] = coverage(p.stdout)
+        for part in ("position after a reset", "yaw after a reset"):
+            self.assertGreater(rows["with"][part][0], 98.0, part)
+            # Without them every pose after a reset is outside: its error is larger than the
+            # path's alone.
+            self.assertLess(rows["without"][part][0], 2.0, part)
+
+    def true_model(self, name, reset_scale=1.0001):
+        """The sigmas the runs were made with, the drifts and resets just above them; with
+        reset_scale None, no reset keys at all (a configuration from before them)."""
+        config = Path(self.tmp.name) / name
         config.write_text(
             "odometry_covariance:\n"
             f"  position_sigma_m: 0.001\n  position_drift: {POSITION_DRIFT * 1.0001}\n"
             f"  tilt_sigma_deg: {TILT_SIGMA_DEG}\n  yaw_sigma_deg: 0.01\n"
             f"  yaw_drift_deg_per_m: {YAW_DRIFT_DEG_PER_M * 1.0001}\n"
-            f"  velocity_sigma_mps: {VELOCITY_SIGMA}\n"
+            + ("" if reset_scale is None else
+               f"  reset_position_sigma_m: {RESET_POSITION_SIGMA * reset_scale}\n"
+               f"  reset_yaw_sigma_deg: {RESET_YAW_SIGMA_DEG * reset_scale}\n")
+            + f"  velocity_sigma_mps: {VELOCITY_SIGMA}\n"
             f"  angular_rate_sigma_rps: {json.dumps(GYRO_SIGMA.tolist())}\n")
+        return config
+
+    def test_a_model_with_the_true_sigmas_holds_68_and_95_percent(self):
+        config = self.true_model("model.yaml")
         p = run_script(f"{self.run_dir}:{self.data}", "--config", config)
         self.assertEqual(p.returncode, 0, p.stderr)
         rows = coverage(p.stdout)
@@ -175,6 +235,7 @@ class OdometryErrorTest(CleanFailureAssertions, unittest.TestCase):
         # the second-order part of the tilt's noise in the yaw and the alignment.
         for name in ("position", "yaw"):
             self.assertGreater(rows[name][0], 98.0, name)
+        self.assertNotIn("position after a reset", rows)  # no reset in this run
 
     def model_with_angular_rate(self, name, angular_rate):
         """A complete odometry_covariance section: 0.01 for every key but the angular rate."""
@@ -204,6 +265,17 @@ class OdometryErrorTest(CleanFailureAssertions, unittest.TestCase):
         self.assertFailsCleanly(run_script(f"{self.run_dir}:{self.data}", "--config", two_axes),
                                 "odometry_covariance.angular_rate_sigma_rps must be a number or "
                                 "a list of 3 numbers (x, y, z), got [0.01, 0.02]")
+
+    def test_a_missing_or_bad_events_log_is_named(self):
+        bare = Path(self.tmp.name) / "no_events"
+        bare.mkdir(exist_ok=True)
+        for name in ("states.csv", "trajectory.tum"):
+            (bare / name).write_text((self.run_dir / name).read_text())
+        self.assertFailsCleanly(run_script(f"{bare}:{self.data}"),
+                                f"{bare / 'events.log'}: cannot read")
+        (bare / "events.log").write_text("1.0 initialized ok\nsoon reset tracking lost\n")
+        self.assertFailsCleanly(run_script(f"{bare}:{self.data}"),
+                                f"{bare / 'events.log'}:2: a reset without a time")
 
     def test_a_short_file_names_its_missing_column(self):
         short = Path(self.tmp.name) / "short"
