@@ -197,7 +197,7 @@ class EstimatorNodelet : public GuardedNodelet {
     earlier_resets_ += estimator_->resetCount() + 1;
     estimator_ = std::make_unique<alvio::Estimator>(config_.estimator, config_.camera, config_.imu);
     feed_ = std::make_unique<alvio::EstimatorKeyframeFeed>(config_.camera.T_b_c);
-    covariance_->reset();
+    covariance_->startNewRun();
     trajectory_.clear();
     path_.poses.clear();
     last_event_.clear();
@@ -249,6 +249,7 @@ class EstimatorNodelet : public GuardedNodelet {
     const int resets_before = estimator_->resetCount();
     const bool has_pose = estimator_->addFrame(fromMsg(features));
     const std::vector<alvio::EstimatorEvent> events = estimator_->takeEvents();
+    for (int r = resets_before; r < estimator_->resetCount(); ++r) covariance_->addEstimatorReset();
     const alvio::LineSegments3 retired = estimator_->takeRetiredLines();
     const double estimator_ms =
         std::chrono::duration<double, std::milli>(Clock::now() - start).count();

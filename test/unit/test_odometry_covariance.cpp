@@ -48,11 +48,40 @@ TEST(OdometryCovariance, PositionAndYawGrowWithThePathTiltAndTwistDoNot) {
   expectDiagonal(model.pose(), {position, position, position, tilt, tilt, yaw});
   expectDiagonal(model.twist(), {1e-4, 1e-4, 1e-4, 6.25e-6, 2.5e-5, 1.6e-5});
   // A new run starts its path again; a non-finite position is not a step.
-  model.reset();
+  model.startNewRun();
   model.addPosition(Eigen::Vector3d(50, 0, 0));
   model.addPosition(Eigen::Vector3d(NAN, 0, 0));
   model.addPosition(Eigen::Vector3d(53, 4, 0));
   EXPECT_NEAR(model.pathLength(), 5.0, 1e-12);
+}
+
+TEST(OdometryCovariance, EachEstimatorResetWidensPositionAndYawUntilANewRun) {
+  OdometryCovarianceOptions o = someOptions();
+  o.reset_position_sigma_m = 0.05;
+  o.reset_yaw_sigma_deg = 0.5;
+  OdometryCovariance model(o);
+  model.addPosition(Eigen::Vector3d(0, 0, 0));
+  model.addPosition(Eigen::Vector3d(50, 0, 0));
+  const double tilt = std::pow(0.2 * kDeg, 2);
+  const double position = 0.03 * 0.03 + 0.1 * 0.1;  // 0.002 m/m over 50 m
+  const double yaw = (1.0 + 0.25) * kDeg * kDeg;    // 0.01 deg/m over 50 m
+  expectDiagonal(model.pose(), {position, position, position, tilt, tilt, yaw});
+  // Two resets: each adds its variance; tilt is gravity's and the twist is the IMU's.
+  model.addEstimatorReset();
+  model.addEstimatorReset();
+  EXPECT_EQ(model.resets(), 2);
+  const double position2 = position + 2 * 0.05 * 0.05, yaw2 = yaw + 2 * 0.25 * kDeg * kDeg;
+  expectDiagonal(model.pose(), {position2, position2, position2, tilt, tilt, yaw2});
+  expectDiagonal(model.twist(), {1e-4, 1e-4, 1e-4, 6.25e-6, 2.5e-5, 1.6e-5});
+  // The resets stay with the run: its output is still re-anchored on the dead reckoning.
+  model.addPosition(Eigen::Vector3d(50, 30, 0));
+  const double position3 = 0.03 * 0.03 + 0.16 * 0.16 + 2 * 0.05 * 0.05;
+  EXPECT_NEAR(model.pose()[0], position3, 1e-15);
+  // A new run starts from its own origin: no reset behind it.
+  model.startNewRun();
+  EXPECT_EQ(model.resets(), 0);
+  model.addPosition(Eigen::Vector3d(0, 0, 0));
+  expectDiagonal(model.pose(), {9e-4, 9e-4, 9e-4, tilt, tilt, std::pow(kDeg, 2)});
 }
 
 TEST(OdometryCovariance, ReadsItsSectionAndNamesABadKey) {
@@ -62,7 +91,8 @@ TEST(OdometryCovariance, ReadsItsSectionAndNamesABadKey) {
   EXPECT_DOUBLE_EQ(o.position_drift, 0.004);
   EXPECT_EQ(o.velocity_sigma_mps, Eigen::Vector3d::Constant(0.05));  // one number: all axes
   EXPECT_DOUBLE_EQ(o.tilt_sigma_deg, OdometryCovarianceOptions().tilt_sigma_deg);
-  for (const char* key : {"position_sigma_m", "yaw_drift_deg_per_m", "angular_rate_sigma_rps"}) {
+  for (const char* key : {"position_sigma_m", "yaw_drift_deg_per_m", "reset_position_sigma_m",
+                          "reset_yaw_sigma_deg", "angular_rate_sigma_rps"}) {
     const YamlReader bad = YamlReader::fromString(
         std::string("odometry_covariance:\n  ") + key + ": -0.1\n", "robot.yaml");
     const std::string error =

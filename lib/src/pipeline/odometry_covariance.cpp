@@ -27,6 +27,8 @@ OdometryCovarianceOptions OdometryCovarianceOptions::load(const YamlReader& yaml
   o.tilt_sigma_deg = yaml.getDouble(p + "tilt_sigma_deg", o.tilt_sigma_deg);
   o.yaw_sigma_deg = yaml.getDouble(p + "yaw_sigma_deg", o.yaw_sigma_deg);
   o.yaw_drift_deg_per_m = yaml.getDouble(p + "yaw_drift_deg_per_m", o.yaw_drift_deg_per_m);
+  o.reset_position_sigma_m = yaml.getDouble(p + "reset_position_sigma_m", o.reset_position_sigma_m);
+  o.reset_yaw_sigma_deg = yaml.getDouble(p + "reset_yaw_sigma_deg", o.reset_yaw_sigma_deg);
   o.velocity_sigma_mps = yaml.getPerAxis(p + "velocity_sigma_mps", o.velocity_sigma_mps);
   o.angular_rate_sigma_rps =
       yaml.getPerAxis(p + "angular_rate_sigma_rps", o.angular_rate_sigma_rps);
@@ -41,6 +43,8 @@ void OdometryCovarianceOptions::validate(const std::string& where) const {
       {"tilt_sigma_deg", tilt_sigma_deg},
       {"yaw_sigma_deg", yaw_sigma_deg},
       {"yaw_drift_deg_per_m", yaw_drift_deg_per_m},
+      {"reset_position_sigma_m", reset_position_sigma_m},
+      {"reset_yaw_sigma_deg", reset_yaw_sigma_deg},
       {"velocity_sigma_mps", velocity_sigma_mps.x()},
       {"velocity_sigma_mps", velocity_sigma_mps.y()},
       {"velocity_sigma_mps", velocity_sigma_mps.z()},
@@ -62,16 +66,23 @@ void OdometryCovariance::addPosition(const Eigen::Vector3d& p) {
   has_position_ = true;
 }
 
-void OdometryCovariance::reset() {
+void OdometryCovariance::startNewRun() {
   path_m_ = 0.0;
+  resets_ = 0;
   has_position_ = false;
 }
 
 Covariance6 OdometryCovariance::pose() const {
   const OdometryCovarianceOptions& o = options_;
-  const double position = std::hypot(o.position_sigma_m, o.position_drift * path_m_);
+  // sqrt(sigma^2 + (drift * path)^2 + resets * reset_sigma^2)
+  const auto grown = [&](double sigma, double drift, double reset_sigma) {
+    return std::sqrt(sigma * sigma + std::pow(drift * path_m_, 2) +
+                     resets_ * reset_sigma * reset_sigma);
+  };
+  const double position = grown(o.position_sigma_m, o.position_drift, o.reset_position_sigma_m);
   const double tilt = o.tilt_sigma_deg * kDegToRad;
-  const double yaw = std::hypot(o.yaw_sigma_deg, o.yaw_drift_deg_per_m * path_m_) * kDegToRad;
+  const double yaw =
+      grown(o.yaw_sigma_deg, o.yaw_drift_deg_per_m, o.reset_yaw_sigma_deg) * kDegToRad;
   return diagonal({position, position, position, tilt, tilt, yaw});
 }
 

@@ -4,7 +4,9 @@
 // covariance. That one would cost a second factorisation a frame, and its position and yaw
 // are a gauge the window barely constrains. Position and yaw are relative to where the
 // odometry started, so their error grows with the path travelled; roll, pitch and the
-// velocity are observed through gravity and stay bounded.
+// velocity are observed through gravity and stay bounded. A reset of the estimator re-anchors
+// the output on the IMU's dead reckoning through the outage, whose error the path does not
+// measure: each one adds its own sigma to position and yaw.
 
 #include <array>
 #include <string>
@@ -24,6 +26,10 @@ struct OdometryCovarianceOptions {
   /// Yaw, 1 sigma: sqrt(yaw_sigma_deg^2 + (yaw_drift_deg_per_m * path)^2).
   double yaw_sigma_deg = 0.067;
   double yaw_drift_deg_per_m = 0.0023;
+  /// Added in quadrature to position and yaw per reset of the estimator, for the rest of
+  /// the run: sqrt(sigma^2 + (drift * path)^2 + resets * reset_sigma^2).
+  double reset_position_sigma_m = 0.0;
+  double reset_yaw_sigma_deg = 0.0;
   // Body frame, per axis (x, y, z); in the file one number for all three or a list of three.
   // A gyroscope on a vibrating body is noisier on some axes (EuRoC's y: 2.6x its x).
   Eigen::Vector3d velocity_sigma_mps = Eigen::Vector3d::Constant(0.006);       ///< linear velocity
@@ -45,9 +51,12 @@ class OdometryCovariance {
 
   /// Adds the step from the last output position to the path travelled.
   void addPosition(const Eigen::Vector3d& p);
-  /// A new run (the clock went back): the path starts again from zero.
-  void reset();
+  /// The estimator reset (tracking lost): the output goes on from the IMU's dead reckoning.
+  void addEstimatorReset() { ++resets_; }
+  /// A new run (the clock went back): the path and the resets count from zero again.
+  void startNewRun();
   double pathLength() const { return path_m_; }
+  int resets() const { return resets_; }
 
   /// (x, y, z, rotation about the world's x, y, z): the pose's order in nav_msgs/Odometry.
   /// The world's z is along gravity, so x and y are tilt and z is yaw.
@@ -58,6 +67,7 @@ class OdometryCovariance {
  private:
   OdometryCovarianceOptions options_;
   double path_m_ = 0.0;
+  int resets_ = 0;
   bool has_position_ = false;
   Eigen::Vector3d last_p_ = Eigen::Vector3d::Zero();
 };
