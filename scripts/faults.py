@@ -8,8 +8,8 @@ run completed (no crash, hang or NaN pose), how often the estimator reset, the A
 before the fault and from the fault on (each SE(3)-aligned on its own), and how long
 it took to track again after the fault ended.
 
-  ./alvio faults [--dataset EUROC_DIR] [--only a,b] [--modes offline,nodelet]
-                 [--rate R] [--out DIR]
+  ./alvio faults [--dataset EUROC_DIR] [--config YAML] [--only a,b]
+                 [--modes offline,nodelet] [--rate R] [--out DIR]
 
 Default input: the demo sequence (30 s figure eight, rendered when missing). The fast
 rotation is rendered by alvio_sim along the input's ground truth with a 360-degree yaw
@@ -297,7 +297,8 @@ def render_fast_rotation(args, env, gt, t_fault, out):
     write_tum(traj, yaw_spin_trajectory(read_tum(gt), t_fault, 1.0))
     log("rendering the fast-rotation sequence (alvio_sim along the spun ground truth)")
     subprocess.run([str(bin_dir / "alvio_sim"), "--trajectory", str(traj), "--still", "0",
-                    "--out", str(folder), "--bag", "--quiet"], env=env, check=True)
+                    "--config", args.config, "--out", str(folder), "--bag", "--quiet"],
+                   env=env, check=True)
     subprocess.run([str(bin_dir / "alvio_euroc_to_bag"), "--dataset", str(folder), "--out",
                     str(folder / "unused.bag"), "--groundtruth", str(folder / "groundtruth.tum")],
                    env=env, check=True, stdout=subprocess.DEVNULL)
@@ -376,7 +377,7 @@ def evaluate(bin_dir, env, gt, traj_path, fault, t_fault, run_dir):
 def run_offline(args, env, bag, run_dir, timeout):
     bin_dir = Path(args.build) / "devel/lib/alvio"
     cmd = [str(bin_dir / "alvio_run"), "--dataset", str(bag), "--out", str(run_dir),
-           "--quiet"]
+           "--config", args.config, "--quiet"]
     with open(run_dir / "run.log", "w") as logf:
         try:
             r = subprocess.run(cmd, env=env, stdout=logf, stderr=subprocess.STDOUT, timeout=timeout)
@@ -413,7 +414,7 @@ def read_recorded(path):
 
 def run_nodelet(args, env, bag, run_dir, timeout):
     cmd = ["bash", str(ROOT / "scripts/ros_demo.sh"), "--bag", str(bag), "--out", str(run_dir),
-           "--rate", str(args.rate), "--record-status"]
+           "--rate", str(args.rate), "--config", args.config, "--record-status"]
     with open(run_dir / "demo.log", "w") as logf:
         try:
             p = subprocess.Popen(cmd, env=env, stdout=logf, stderr=subprocess.STDOUT,
@@ -464,6 +465,12 @@ def main():
                                  formatter_class=argparse.RawDescriptionHelpFormatter,
                                  epilog="faults: " + ", ".join(f.name for f in FAULTS))
     ap.add_argument("--dataset", help="EuRoC folder with ground truth (default: the demo sequence)")
+    # Given to the offline and the nodelet runs alike (ros_demo.sh does not read ALVIO_CONFIG);
+    # a real IMU's sequence wants config/euroc_real.yaml.
+    ap.add_argument("--config",
+                    default=os.environ.get("ALVIO_CONFIG", str(ROOT / "config/euroc.yaml")),
+                    help="alvio configuration of every run (default: $ALVIO_CONFIG, else "
+                         "config/euroc.yaml)")
     ap.add_argument("--only", help="comma-separated fault names")
     ap.add_argument("--modes", default="offline,nodelet")
     ap.add_argument("--rate", type=float, default=0.5, help="nodelet playback rate")
@@ -473,6 +480,9 @@ def main():
     ap.add_argument("--keep-bags", action="store_true", help="keep each faulted bag")
     ap.add_argument("--build", default=os.environ.get("ALVIO_BUILD_DIR", str(ROOT / "build")))
     args = ap.parse_args()
+    if not Path(args.config).is_file():
+        sys.exit(f"faults: --config {args.config}: no such file")
+    args.config = str(Path(args.config).resolve())
     modes = args.modes.split(",")
     for m in modes:
         if m not in ("offline", "nodelet"):
