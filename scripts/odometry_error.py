@@ -77,7 +77,9 @@ def run_errors(run, dataset):
     imu = load_table(dataset / "mav0/imu0/data.csv", IMU_COLUMNS, delimiter=",")
     if len(states) != len(est) or np.max(np.abs(states[:, 0] - est[:, 0])) > 1e-4:
         fail(f"{run}: states.csv and trajectory.tum do not have the same poses")
+    # A reset before the first output pose (while initialising) re-anchors nothing.
     reset_times = load_reset_times(run / "events.log")
+    reset_times = reset_times[reset_times > est[0, 0]]
     t_gt, t_imu = gt[:, 0] * 1e-9, imu[:, 0] * 1e-9
     inside = (est[:, 0] > t_gt[0] + 0.01) & (est[:, 0] < t_gt[-1] - 0.01)
     if inside.sum() < 2:

@@ -112,7 +112,10 @@ def make_run(folder, seed, resets=()):
                comments="")
     # As the offline runner logs them: "<t> <kind> <message>".
     start = t_ns[0] * 1e-9
-    events = [f"{stamps[0]:.6f} initialized estimator ready\n"] + [
+    # A reset while initialising, before the first output pose, re-anchors nothing: the
+    # script must not count it (nor does the nodelet).
+    early = [f"{stamps[0] - 0.5:.6f} reset initialisation failed\n"] if resets else []
+    events = early + [f"{stamps[0]:.6f} initialized estimator ready\n"] + [
         f"{start + r:.6f} reset tracking lost: too few features\n" for r in resets]
     (run / "events.log").write_text("".join(events))
     return run, folder / "data"

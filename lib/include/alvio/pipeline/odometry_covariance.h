@@ -52,7 +52,8 @@ class OdometryCovariance {
   /// Adds the step from the last output position to the path travelled.
   void addPosition(const Eigen::Vector3d& p);
   /// The estimator reset (tracking lost): the output goes on from the IMU's dead reckoning.
-  void addEstimatorReset() { ++resets_; }
+  /// One before the first output (while initialising) re-anchors nothing and is not counted.
+  void addEstimatorReset() { resets_ += has_position_ ? 1 : 0; }
   /// A new run (the clock went back): the path and the resets count from zero again.
   void startNewRun();
   double pathLength() const { return path_m_; }
