@@ -23,8 +23,8 @@ It prints each run's errors, then the sigmas fitted over all runs: the angular r
 axis (a gyroscope on a vibrating body is noisier on some axes), velocity and tilt the largest
 per-axis RMS, position and yaw the least-squares fit of e^2 = s0^2 + (k d)^2 + n r^2 (d the
 path, n the resets before the pose; r is fitted only when the runs have a reset). With
---config it also prints how often that configuration's model holds each error within 1 and 2 sigma (a
-Gaussian: 68 % and 95 %), to check sigmas on runs that did not set them.
+--config it also prints how often that configuration's model holds each error within 1 and 2
+sigma (a Gaussian: 68 % and 95 %), to check sigmas on runs that did not set them.
 """
 import argparse
 import sys
