@@ -239,11 +239,7 @@ class EstimatorNodelet : public GuardedNodelet {
   }
 
   void process(const Sync::Ready& ready) {
-    for (const alvio::ImuSample& s : ready.imu) {
-      estimator_->addImu(s);
-      // The odometry's angular rate: the newest finite one (the estimator drops the rest).
-      if (s.gyr.allFinite()) last_gyr_ = s.gyr;
-    }
+    for (const alvio::ImuSample& s : ready.imu) estimator_->addImu(s);
     const alvio::TrackedFeatures& features = ready.frame->features;
     const auto start = Clock::now();
     const int resets_before = estimator_->resetCount();
@@ -301,7 +297,9 @@ class EstimatorNodelet : public GuardedNodelet {
     odometry->pose.pose = toPose(state.p, state.q);
     // nav_msgs/Odometry: the twist is in the child (body) frame.
     const Eigen::Vector3d v_b = state.q.conjugate() * state.v;
-    const Eigen::Vector3d w_b = last_gyr_ - state.bg;
+    // At the frame's stamp: the sample after it lags up to one IMU period, on a fast turn
+    // several times the gyroscope's noise.
+    const Eigen::Vector3d w_b = estimator_->gyroAtLatestFrame() - state.bg;
     odometry->twist.twist.linear.x = v_b.x();
     odometry->twist.twist.linear.y = v_b.y();
     odometry->twist.twist.linear.z = v_b.z();
@@ -444,7 +442,6 @@ class EstimatorNodelet : public GuardedNodelet {
   alvio::Trajectory trajectory_;
   int finished_runs_ = 0, earlier_resets_ = 0;
   nav_msgs::Path path_;
-  Eigen::Vector3d last_gyr_ = Eigen::Vector3d::Zero();
   std::string last_event_;
   uint32_t frames_ = 0;
   std::size_t dropped_frames_ = 0, dropped_imu_ = 0;

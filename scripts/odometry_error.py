@@ -16,7 +16,7 @@ the estimator nodelet's odometry message:
   far (events.log): after each, the output goes on from the IMU's dead reckoning;
 - tilt: the orientation's error about the world's x and y axes (gravity's direction);
 - velocity in the body frame (R^T v), which no alignment changes;
-- angular rate: the first IMU sample after the frame less the estimated gyroscope bias (what
+- angular rate: the gyroscope interpolated at the frame's stamp less the estimated bias (what
   the nodelet publishes), against the truth's rate.
 
 It prints each run's errors, then the sigmas fitted over all runs: the angular rate's RMS per
@@ -105,14 +105,14 @@ def run_errors(run, dataset):
     rot_err = np.degrees(rotation_log(np.einsum("ij,njk,nlk->nil", Rz, R_est, R_gt)))
     path = np.concatenate([[0], np.cumsum(np.linalg.norm(np.diff(p_gt, axis=0), axis=1))])
     resets = np.searchsorted(reset_times, t, side="right")  # resets at or before each pose
-    # Angular rate: the first IMU sample after the frame (the last the nodelet is given with
-    # it), less the estimated bias.
-    j = np.clip(np.searchsorted(t_imu, t, side="right"), 0, len(t_imu) - 1)
+    # Angular rate: the gyroscope interpolated at the frame's stamp, less the estimated bias
+    # (Estimator::gyroAtLatestFrame; np.interp holds the last sample as the estimator does).
+    gyro = np.stack([np.interp(t, t_imu, imu[:, 1 + k]) for k in range(3)], 1)
     h = 0.0025
     Rp = quat_to_matrix(interpolate_quaternions(np.clip(t + h, t_gt[0], t_gt[-1]), t_gt, q_gt_all))
     Rm = quat_to_matrix(interpolate_quaternions(np.clip(t - h, t_gt[0], t_gt[-1]), t_gt, q_gt_all))
     rate_gt = rotation_log(np.einsum("nji,njk->nik", Rm, Rp)) / (2 * h)
-    rate_err = imu[j, 1:4] - states[:, 7:10] - rate_gt
+    rate_err = gyro - states[:, 7:10] - rate_gt
     return {"path": path, "resets": resets, "position": p_est - p_gt, "yaw": rot_err[:, 2],
             "tilt": rot_err[:, :2], "velocity": v_body - v_body_gt, "rate": rate_err}
 

@@ -130,6 +130,35 @@ TEST(Estimator, InitialisesAndTracksSyntheticFeatures) {
   EXPECT_LT(e.ate_rotation_deg.rmse, 1.0);
 }
 
+// The odometry's angular rate is the gyroscope at the frame's stamp, not the sample after it.
+TEST(Estimator, GyroAtTheLatestFrameIsInterpolatedAtItsStamp) {
+  const Config c = Config::load(test::sourcePath("config/euroc.yaml"));
+  Estimator estimator(c.estimator, c.camera, c.imu);
+  const auto imu = [&](int64_t t_ns, double wx) {
+    ImuSample s;
+    s.t_ns = t_ns;
+    s.gyr = Eigen::Vector3d(wx, -2 * wx, 0.5);
+    s.acc = Eigen::Vector3d(0, 0, 9.81);
+    estimator.addImu(s);
+  };
+  const auto frame = [&](int64_t t_ns) {
+    FeatureFrame f;
+    f.t_ns = t_ns;
+    estimator.addFrame(f);
+    return estimator.gyroAtLatestFrame();
+  };
+  const int64_t t0 = 1'000'000'000;
+  imu(t0, 0.1);
+  imu(t0 + 5'000'000, 0.3);
+  // 2 ms into the 5 ms between the samples: 0.1 + 0.4 * (0.3 - 0.1).
+  EXPECT_TRUE(frame(t0 + 2'000'000).isApprox(Eigen::Vector3d(0.18, -0.36, 0.5), 1e-12));
+  // On a sample: that sample.
+  imu(t0 + 10'000'000, 0.7);
+  EXPECT_TRUE(frame(t0 + 5'000'000).isApprox(Eigen::Vector3d(0.3, -0.6, 0.5), 1e-12));
+  // No sample after the frame yet: the last one held.
+  EXPECT_TRUE(frame(t0 + 12'000'000).isApprox(Eigen::Vector3d(0.7, -1.4, 0.5), 1e-12));
+}
+
 TEST(Estimator, IsDeterministic) {
   const Config c = Config::load(test::sourcePath("config/euroc.yaml"));
   test::ScenarioOptions so;

@@ -121,6 +121,9 @@ class Estimator {
   EstimatorStatus status() const { return settling_ ? EstimatorStatus::kInitializing : status_; }
   /// State of the newest frame, in the output world frame.
   BodyState latestState() const;
+  /// The gyroscope at the newest frame's time: interpolated between the samples around it,
+  /// or the last one held when the next has not come. Less bg, the body's angular rate.
+  const Eigen::Vector3d& gyroAtLatestFrame() const { return gyr_0_; }
   /// Keyframe states of the window, oldest first, in the output world frame.
   std::vector<BodyState, Eigen::aligned_allocator<BodyState>> windowStates() const;
   /// Triangulated landmarks in the output world frame, by id.
