@@ -31,7 +31,7 @@ struct OdometryCovarianceOptions {
   double reset_position_sigma_m = 0.0;
   double reset_yaw_sigma_deg = 0.0;
   // Body frame, per axis (x, y, z); in the file one number for all three or a list of three.
-  // A gyroscope on a vibrating body is noisier on some axes (EuRoC's y: 2.6x its x).
+  // A gyroscope on a vibrating body is noisier on some axes (EuRoC's y: 4.7x its x).
   Eigen::Vector3d velocity_sigma_mps = Eigen::Vector3d::Constant(0.006);       ///< linear velocity
   Eigen::Vector3d angular_rate_sigma_rps = Eigen::Vector3d::Constant(0.0025);  ///< angular rate
 
