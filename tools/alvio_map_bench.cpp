@@ -7,6 +7,7 @@
 #include <iomanip>
 #include <iostream>
 
+#include "alvio/common/angles.h"
 #include "alvio/common/arg_parser.h"
 #include "alvio/common/error.h"
 #include "alvio/mapping/map_builder.h"
@@ -94,7 +95,7 @@ int main(int argc, char** argv) {
 
     std::vector<Segment3> kept;
     for (const MapLine& l : builder.lineMap().filteredLines()) kept.push_back(l.segment());
-    const LineMapEvaluation le = evaluateLineMap(kept, room.edges, 0.10, 3.0 * M_PI / 180);
+    const LineMapEvaluation le = evaluateLineMap(kept, room.edges, 0.10, 3.0 * kDegToRad);
     std::cout << std::setprecision(1) << "line map (10 cm, 3 deg): precision " << 100 * le.precision
               << " % of " << le.map_length_m << " m, recall " << 100 * le.recall << " % of "
               << le.true_length_m << " m true edges\n";

@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "alvio/common/angles.h"
 #include "alvio/common/arg_parser.h"
 #include "alvio/common/error.h"
 #include "alvio/eval/trajectory_evaluation.h"
@@ -186,10 +187,10 @@ int main(int argc, char** argv) {
         const Segment3 s{traj.alignment.apply(l.p0), traj.alignment.apply(l.p1)};
         const LineError e = lineErrorToNearestEdge(s, edges);
         const LineMapEvaluation one = evaluateLineMap({s}, edges, options.line_distance_tol_m,
-                                                      options.line_angle_tol_deg * M_PI / 180.0);
+                                                      options.line_angle_tol_deg * kDegToRad);
         const LineError et = lineErrorToNearestEdge(s, all_edges);
         const LineMapEvaluation one_t = evaluateLineMap({s}, all_edges, options.line_distance_tol_m,
-                                                        options.line_angle_tol_deg * M_PI / 180.0);
+                                                        options.line_angle_tol_deg * kDegToRad);
         os << l.id << "," << s.length() << "," << l.observations << "," << l.landmarks << ","
            << e.edge << "," << e.angle_deg << "," << e.midpoint_distance_m << ","
            << lineSurfaceDistance(s, surface_distance) << "," << surfaces(0.5 * (s.p0 + s.p1))

@@ -1,4 +1,5 @@
 #include "alvio/mapping/estimator_keyframe_feed.h"
+#include "alvio/common/angles.h"
 
 #include <algorithm>
 #include <cmath>
@@ -16,7 +17,7 @@ double parallaxDeg(const Eigen::Vector3d& p, const std::vector<Eigen::Vector3d>&
     const Eigen::Vector3d b = (centres[k] - p).normalized();
     max_angle = std::max(max_angle, std::atan2(a.cross(b).norm(), a.dot(b)));
   }
-  return max_angle * 180.0 / M_PI;
+  return max_angle * kRadToDeg;
 }
 }  // namespace
 

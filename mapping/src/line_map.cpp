@@ -7,6 +7,7 @@
 #include <limits>
 #include <sstream>
 
+#include "alvio/common/angles.h"
 #include "alvio/common/error.h"
 #include "alvio/config/yaml_reader.h"
 
@@ -43,7 +44,7 @@ LineMapOptions LineMapOptions::load(const YamlReader& yaml, const std::string& p
 }
 
 LineMap::LineMap(const LineMapOptions& options)
-    : options_(options), cos_merge_angle_(std::cos(options.merge_angle_deg * M_PI / 180.0)) {}
+    : options_(options), cos_merge_angle_(std::cos(options.merge_angle_deg * kDegToRad)) {}
 
 bool LineMap::addSegment(int id, const Eigen::Vector3d& p0_w, const Eigen::Vector3d& p1_w,
                          int observations, const Eigen::Vector3d& camera_w, double midpoint_std_m) {

@@ -1,4 +1,5 @@
 #include "alvio/mapping/map_truth_evaluation.h"
+#include "alvio/common/angles.h"
 
 #include <algorithm>
 #include <cmath>
@@ -32,7 +33,7 @@ LineError lineErrorToNearestEdge(const Segment3& line, const std::vector<Segment
   }
   if (out.edge < 0) return out;
   const Segment3& e = true_edges[out.edge];
-  out.angle_deg = lineAngle(line.direction(), e.direction()) * 180.0 / M_PI;
+  out.angle_deg = lineAngle(line.direction(), e.direction()) * kRadToDeg;
   out.midpoint_distance_m = pointLineDistance(mid, e.p0, e.direction());
   return out;
 }
@@ -71,7 +72,7 @@ MapTruthEvaluation evaluateMapAgainstTruth(const std::vector<Segment3>& lines_es
   MapTruthEvaluation out;
   out.line_errors = summariseLineErrors(lines, true_edges);
   out.line_map = evaluateLineMap(lines, true_edges, options.line_distance_tol_m,
-                                 options.line_angle_tol_deg * M_PI / 180.0);
+                                 options.line_angle_tol_deg * kDegToRad);
   double total = 0, on_surface = 0;
   for (const Segment3& l : lines) {
     total += l.length();

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <limits>
 
+#include "alvio/common/angles.h"
 #include "alvio/common/clock_jump.h"
 #include "alvio/common/error.h"
 #include "alvio/common/logging.h"
@@ -346,7 +347,7 @@ bool Estimator::detectFailure(std::string* why) const {
   if (std::abs(Ps_[W_].z() - last_P_.z()) > options_.max_z_jump_m)
     return fail("height jumped " + std::to_string(std::abs(Ps_[W_].z() - last_P_.z())) +
                 " m in one frame");
-  const double angle = Eigen::AngleAxisd(last_R_.transpose() * Rs_[W_]).angle() * 180.0 / M_PI;
+  const double angle = Eigen::AngleAxisd(last_R_.transpose() * Rs_[W_]).angle() * kRadToDeg;
   if (angle > options_.max_rotation_jump_deg)
     return fail("rotation jumped " + std::to_string(angle) + " deg in one frame");
   return false;

@@ -6,6 +6,7 @@
 #include <map>
 #include <sstream>
 
+#include "alvio/common/angles.h"
 #include "alvio/common/logging.h"
 #include "alvio/common/rotation.h"
 #include "alvio/estimator/estimator.h"
@@ -190,7 +191,7 @@ bool Estimator::alignWithImu(double t) {
     for (std::size_t k = 1; k < frames.size(); ++k) {
       const Eigen::Quaterniond q_vis(frames[k - 1].R_c0_b.transpose() * frames[k].R_c0_b);
       logDebug("align: frame ", k, " dt ", frames[k].imu->sumDt(), " visual-vs-imu rotation ",
-               q_vis.angularDistance(frames[k].imu->deltaQ()) * 180 / M_PI, " deg, visual step ",
+               q_vis.angularDistance(frames[k].imu->deltaQ()) * kRadToDeg, " deg, visual step ",
                (frames[k].p_c0_c - frames[k - 1].p_c0_c).norm());
     }
   }

@@ -1,4 +1,5 @@
 #include "alvio/eval/line_truth_association.h"
+#include "alvio/common/angles.h"
 
 #include <algorithm>
 #include <cmath>
@@ -10,7 +11,7 @@ EdgeAssociation associateWithEdge(const LineSegment& segment, const ProjectedEdg
   EdgeAssociation out;
   const double length = segment.length();
   if (!(length > 0)) return out;
-  const double max_angle = options.max_angle_deg * M_PI / 180.0;
+  const double max_angle = options.max_angle_deg * kDegToRad;
   double best = 0;
   for (const ProjectedEdge& e : edges) {
     const LineSegment edge(e.a, e.b);
@@ -31,7 +32,7 @@ EdgeAssociation associateWithEdge(const LineSegment& segment, const ProjectedEdg
       out.endpoint_distance_px = d;
       out.start_distance_px = d_start;
       out.end_distance_px = d_end;
-      out.angle_deg = angle * 180.0 / M_PI;
+      out.angle_deg = angle * kRadToDeg;
     }
   }
   return out;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numeric>
 
+#include "alvio/common/angles.h"
 #include "alvio/common/error.h"
 
 namespace alvio {
@@ -64,7 +65,7 @@ ErrorStats ErrorStats::of(std::vector<double> v) {
 namespace {
 double rotationAngleDeg(const Eigen::Matrix3d& R) {
   const double c = std::clamp((R.trace() - 1.0) / 2.0, -1.0, 1.0);
-  return std::acos(c) * 180.0 / M_PI;
+  return std::acos(c) * kRadToDeg;
 }
 }  // namespace
 

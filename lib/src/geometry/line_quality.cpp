@@ -6,6 +6,7 @@
 #include <limits>
 #include <vector>
 
+#include "alvio/common/angles.h"
 #include "alvio/geometry/line_projection_factor.h"
 #include "alvio/geometry/orthonormal_line.h"
 #include "alvio/geometry/orthonormal_line_manifold.h"
@@ -96,7 +97,7 @@ bool tangentCovariance(const double* x, const LineViews& views, double sigma, Ei
 
 // dtheta_x and dtheta_z turn the direction.
 double directionStdDeg(const Eigen::Matrix4d& C) {
-  return std::sqrt(std::max(0.0, C(0, 0) + C(2, 2))) * 180.0 / M_PI;
+  return std::sqrt(std::max(0.0, C(0, 0) + C(2, 2))) * kRadToDeg;
 }
 }  // namespace
 

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "alvio/common/angles.h"
 #include "alvio/common/clock_jump.h"
 #include "alvio/common/error.h"
 #include "alvio/common/logging.h"
@@ -37,7 +38,7 @@ double firstMotion(const Trajectory& gt) {
     if (dt <= 0) continue;
     const double v = (gt[i].p - gt[i - 10].p).norm() / dt;
     const double w = gt[i].q.angularDistance(gt[i - 10].q) / dt;
-    if (v > 0.1 || w > 10.0 * M_PI / 180) return gt[i - 10].t;
+    if (v > 0.1 || w > 10.0 * kDegToRad) return gt[i - 10].t;
   }
   return gt.empty() ? 0 : gt.front().t;
 }
@@ -73,7 +74,7 @@ InitializationQuality initializationQuality(
     // Gravity direction in the body frame, estimated vs true.
     const Eigen::Vector3d z_est = s.q.inverse() * Eigen::Vector3d::UnitZ();
     const Eigen::Vector3d z_gt = g->q.inverse() * Eigen::Vector3d::UnitZ();
-    gravity_err += std::acos(std::clamp(z_est.dot(z_gt), -1.0, 1.0)) * 180.0 / M_PI;
+    gravity_err += std::acos(std::clamp(z_est.dot(z_gt), -1.0, 1.0)) * kRadToDeg;
     ++n;
   }
   if (n >= 3) {

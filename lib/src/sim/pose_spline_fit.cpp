@@ -7,6 +7,7 @@
 #include <iomanip>
 #include <sstream>
 
+#include "alvio/common/angles.h"
 #include "alvio/common/error.h"
 #include "alvio/sim/so3.h"
 
@@ -200,7 +201,7 @@ SplineFitReport evaluateSplineFit(const PoseSpline& spline, const Trajectory& sa
     if (!spline.contains(s.t)) continue;
     const BodyState st = spline.state(s.t);
     const double ep = (st.p_w - s.p).norm();
-    const double er = so3Log(Eigen::Quaterniond(s.q.conjugate() * st.q_w_b)).norm() * 180 / M_PI;
+    const double er = so3Log(Eigen::Quaterniond(s.q.conjugate() * st.q_w_b)).norm() * kRadToDeg;
     sum_p += ep * ep;
     sum_r += er * er;
     if (ep > r.position_max_m) {

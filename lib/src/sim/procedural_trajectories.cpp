@@ -3,6 +3,7 @@
 #include <cmath>
 #include <functional>
 
+#include "alvio/common/angles.h"
 #include "alvio/common/error.h"
 
 namespace alvio::sim {
@@ -91,7 +92,7 @@ Trajectory figureEight(const ProceduralPathOptions& o) {
 Trajectory corridorWalk(const ProceduralPathOptions& o) {
   const CorridorWalkOptions& c = o.corridor;
   const double lap = 2 * c.length_m / c.speed_mps;  // there and back
-  const double sway = c.look_around_deg * M_PI / 180;
+  const double sway = c.look_around_deg * kDegToRad;
   auto path = [&](double s, Eigen::Vector3d* p, Eigen::Vector3d* look) {
     // x follows a smooth back-and-forth (cosine) so the turn-around is not a cusp.
     const double phase = 2 * M_PI * s / lap;

@@ -8,6 +8,7 @@
 #include <set>
 #include <sstream>
 
+#include "alvio/common/angles.h"
 #include "alvio/common/error.h"
 #include "alvio/common/logging.h"
 #include "alvio/common/resource_path.h"
@@ -116,12 +117,12 @@ class Node {
 };
 
 Eigen::Matrix3d yawMatrix(double yaw_deg) {
-  return Eigen::AngleAxisd(yaw_deg * M_PI / 180, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  return Eigen::AngleAxisd(yaw_deg * kDegToRad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
 }
 
 Eigen::Matrix3d rotationOf(const Node& o) {
   if (o.has("rotation_deg")) {
-    const Eigen::Vector3d r = o.vec3("rotation_deg") * M_PI / 180;  // roll, pitch, yaw
+    const Eigen::Vector3d r = o.vec3("rotation_deg") * kDegToRad;  // roll, pitch, yaw
     return (Eigen::AngleAxisd(r.z(), Eigen::Vector3d::UnitZ()) *
             Eigen::AngleAxisd(r.y(), Eigen::Vector3d::UnitY()) *
             Eigen::AngleAxisd(r.x(), Eigen::Vector3d::UnitX()))

@@ -13,6 +13,7 @@
 #include <sstream>
 #include <thread>
 
+#include "alvio/common/angles.h"
 #include "alvio/common/error.h"
 #include "alvio/common/logging.h"
 #include "alvio/common/progress_bar.h"
@@ -118,7 +119,7 @@ std::vector<int64_t> readStamps(const std::string& path) {
 bool startsMoving(const Trajectory& t) {
   for (const StampedPose& p : t) {
     if (p.t > t.front().t + 1.0) break;
-    if ((p.p - t.front().p).norm() > 0.01 || p.q.angularDistance(t.front().q) > 0.5 * M_PI / 180)
+    if ((p.p - t.front().p).norm() > 0.01 || p.q.angularDistance(t.front().q) > 0.5 * kDegToRad)
       return true;
   }
   return false;
