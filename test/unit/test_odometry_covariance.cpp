@@ -119,7 +119,7 @@ TEST(OdometryCovariance, TheTwistsSigmasMayDifferPerAxis) {
       {"[0.018, 0.05]",
        "robot.yaml: key 'odometry_covariance.angular_rate_sigma_rps' must have 3 values"},
       {"[0.018, -0.05, 0.03]",
-       "robot.yaml: odometry_covariance.angular_rate_sigma_rps must be a "
+       "robot.yaml: odometry_covariance.angular_rate_sigma_rps[1] must be a "
        "finite value >= 0, got -0.05"},
       {"{x: 1}",
        "robot.yaml: key 'odometry_covariance.angular_rate_sigma_rps' must be a number or a list of "

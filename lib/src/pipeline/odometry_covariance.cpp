@@ -37,25 +37,23 @@ OdometryCovarianceOptions OdometryCovarianceOptions::load(const YamlReader& yaml
 }
 
 void OdometryCovarianceOptions::validate(const std::string& where) const {
-  const std::pair<const char*, double> values[] = {
-      {"position_sigma_m", position_sigma_m},
-      {"position_drift", position_drift},
-      {"tilt_sigma_deg", tilt_sigma_deg},
-      {"yaw_sigma_deg", yaw_sigma_deg},
-      {"yaw_drift_deg_per_m", yaw_drift_deg_per_m},
-      {"reset_position_sigma_m", reset_position_sigma_m},
-      {"reset_yaw_sigma_deg", reset_yaw_sigma_deg},
-      {"velocity_sigma_mps", velocity_sigma_mps.x()},
-      {"velocity_sigma_mps", velocity_sigma_mps.y()},
-      {"velocity_sigma_mps", velocity_sigma_mps.z()},
-      {"angular_rate_sigma_rps", angular_rate_sigma_rps.x()},
-      {"angular_rate_sigma_rps", angular_rate_sigma_rps.y()},
-      {"angular_rate_sigma_rps", angular_rate_sigma_rps.z()}};
-  for (const auto& [key, value] : values) {
-    if (std::isfinite(value) && value >= 0) continue;
+  const auto check = [&](const std::string& key, double value) {
+    if (std::isfinite(value) && value >= 0) return;
     std::ostringstream os;
     os << where << "." << key << " must be a finite value >= 0, got " << value;
     throw Error(os.str());
+  };
+  check("position_sigma_m", position_sigma_m);
+  check("position_drift", position_drift);
+  check("tilt_sigma_deg", tilt_sigma_deg);
+  check("yaw_sigma_deg", yaw_sigma_deg);
+  check("yaw_drift_deg_per_m", yaw_drift_deg_per_m);
+  check("reset_position_sigma_m", reset_position_sigma_m);
+  check("reset_yaw_sigma_deg", reset_yaw_sigma_deg);
+  for (int axis = 0; axis < 3; ++axis) {  // named as the file's list: key[axis]
+    const std::string index = "[" + std::to_string(axis) + "]";
+    check("velocity_sigma_mps" + index, velocity_sigma_mps[axis]);
+    check("angular_rate_sigma_rps" + index, angular_rate_sigma_rps[axis]);
   }
 }
 
