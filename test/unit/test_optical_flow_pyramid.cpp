@@ -154,7 +154,9 @@ TEST(PyramidHistory, EachFrameRefillsTheBuffersOfTheOneTwoFramesBack) {
       EXPECT_EQ(history.previous()[0].data, buffers[k - 1]);
       EXPECT_EQ(cv::norm(history.previous()[0], frames[k - 1], cv::NORM_INF), 0.0);
     }
-    if (k > 1) EXPECT_EQ(current[0].data, buffers[k - 2]) << "frame " << k;
+    if (k > 1) {
+      EXPECT_EQ(current[0].data, buffers[k - 2]) << "frame " << k;
+    }
     buffers.push_back(current[0].data);
     history.advance();
   }
