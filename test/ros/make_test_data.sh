@@ -2,6 +2,8 @@
 # The ROS tests' input, made in OUT (the build tree), reused while still valid:
 #   sim.bag            the first DURATION s of the simulated demo sequence (alvio_euroc_to_bag)
 #   groundtruth.tum    its ground truth
+#   reset.bag          the first RESET_DURATION s with a blackout RESET_AT s in (scripts/faults.py's
+#                      black_then_saturated: 1 s black, 1 s saturated): the estimator resets
 #   offline/           the offline runner (alvio_run) on sim.bag, OpenCV on one thread: the
 #                      reference of the nodelet pipeline and of the in-process regression run
 #                      (OpenCV's worker threads must not change the result); redone whenever
@@ -15,6 +17,7 @@
 set -euo pipefail
 out="$1" bin="$2" src="$3"
 duration="${ALVIO_ROS_TEST_DURATION:-16}"
+reset_duration=20 reset_at=8
 mkdir -p "$out"
 rm -f "$out/UNAVAILABLE"
 
@@ -39,6 +42,18 @@ if [[ ! -f $out/sim.bag || ! -f $out/groundtruth.tum || "$(cat "$out/source.txt"
     --groundtruth "$out/groundtruth.tum"
   echo "$stamp" >"$out/source.txt"
   rm -rf "$out/offline"
+fi
+
+# The blackout bag: remade with the bag above, or when the fault's code changes.
+reset_stamp="$stamp $reset_duration $reset_at $(stat -c %Y "$src/scripts/faults.py")"
+if [[ ! -f $out/reset.bag || "$(cat "$out/reset_source.txt" 2>/dev/null)" != "$reset_stamp" ]]; then
+  "$bin/alvio_euroc_to_bag" --dataset "$demo" --out "$out/reset_clean.bag" \
+    --duration "$reset_duration"
+  # Debian's python: rosbag and numpy (a pyenv python first on PATH has neither).
+  /usr/bin/python3 "$src/test/ros/make_fault_bag.py" "$out/reset_clean.bag" \
+    black_then_saturated "$reset_at" "$out/reset.bag"
+  rm -f "$out/reset_clean.bag"
+  echo "$reset_stamp" >"$out/reset_source.txt"
 fi
 
 # The offline reference: redone when the bag, alvio_run or a library it uses was rebuilt.

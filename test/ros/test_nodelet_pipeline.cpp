@@ -8,6 +8,8 @@
 // nodelets unload (writing their files) and reload, and that bad parameters leave
 // a nodelet unloaded and the manager running. nodelet_replay.test plays the bag twice (a
 // looping player, its clock jumping back): every nodelet must start a new run.
+// nodelet_reset.test plays a bag with a blackout: the estimator resets, tracks again, and
+// the odometry's covariance widens by the reset's sigma (config odometry_covariance).
 #include <gtest/gtest.h>
 #include <nav_msgs/Odometry.h>
 #include <nodelet/NodeletList.h>
@@ -23,15 +25,18 @@
 #include <alvio/ZeroCopyReport.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <mutex>
 #include <set>
 
 #include "alvio/common/clock_jump.h"
+#include "alvio/config/config.h"
 #include "alvio/eval/trajectory_evaluation.h"
 #include "alvio/io/trajectory_io.h"
 #include "alvio/pipeline/frame_imu_sync.h"
+#include "alvio/pipeline/odometry_covariance.h"
 
 namespace fs = std::filesystem;
 
@@ -41,7 +46,9 @@ struct Settings {
   std::string data_dir, output_dir, ns = "/alvio", manager, player = "/player";
   std::vector<std::string> nodelets;  // expected in the manager (manager mode)
   bool expect_shared = true, check_ate = true, check_reload = true, check_zero_copy = true;
-  bool replay = false;  // the player loops: pause it in its second play
+  bool replay = false;          // the player loops: pause it in its second play
+  std::string bag = "sim.bag";  // in data_dir: what the player plays
+  bool expect_reset = false;    // the bag has a blackout that resets the estimator
   double camera_rate_hz = 20;
 };
 
@@ -209,6 +216,7 @@ alvio::Trajectory recordedTrajectory(std::size_t n = 0) {
 }  // namespace
 
 TEST(NodeletPipeline, OdometryAndTfArriveAtTheImageRateWithImageStamps) {
+  if (g_settings.expect_reset) GTEST_SKIP() << "the blackout stops the odometry until it resets";
   REQUIRE_DATA();
   std::lock_guard<std::mutex> lock(g_rec.mutex);
   const alvio::PipelineStatus status = g_rec.latestStatus();
@@ -484,6 +492,73 @@ TEST(NodeletPipeline, ABagPlayedAgainIsANewRunInEveryNodelet) {
   EXPECT_FALSE(fs::exists(out + "/run2")) << "one clock jump is one new run";
 }
 
+// The blackout of nodelet_reset.test: the estimator resets and tracks again, and from the
+// reset on the odometry's position (and yaw) variance carries the reset's: the covariance
+// the nodelet publishes is the model's (OdometryCovariance) fed with the published positions
+// and the resets the status reports, nothing more and nothing less.
+TEST(NodeletPipeline, AResetWidensTheOdometrysCovarianceByTheResetsSigma) {
+  if (!g_settings.expect_reset) GTEST_SKIP() << "no blackout in this configuration";
+  REQUIRE_DATA();
+  std::string config_file;
+  ASSERT_TRUE(ros::param::get(g_settings.ns + "/config_file", config_file))
+      << g_settings.ns << "/config_file is not set";
+  const alvio::OdometryCovarianceOptions options =
+      alvio::Config::load(config_file).odometry_covariance;
+  ASSERT_GT(options.reset_position_sigma_m, 0.0)
+      << config_file << ": odometry_covariance/reset_position_sigma_m must be set for this test";
+
+  std::lock_guard<std::mutex> lock(g_rec.mutex);
+  ASSERT_FALSE(g_rec.odometry.empty()) << "no odometry: the estimator never initialised";
+  // The frames whose status counts a reset more than the one before, and by how many.
+  std::vector<std::pair<int64_t, int>> resets;
+  int reset_count = 0;
+  for (const alvio::PipelineStatus& m : g_rec.statuses) {
+    if (m.reset_count > reset_count)
+      resets.emplace_back(static_cast<int64_t>(m.header.stamp.toNSec()),
+                          m.reset_count - reset_count);
+    reset_count = m.reset_count;
+  }
+  const int64_t first_odometry = g_rec.odometry.front().first;
+  const auto reset_after_output = std::find_if(
+      resets.begin(), resets.end(), [&](const auto& r) { return r.first > first_odometry; });
+  ASSERT_NE(reset_after_output, resets.end())
+      << "the blackout did not reset the estimator once it had output (" << resets.size()
+      << " resets before the first odometry)";
+  const int64_t reset_at = reset_after_output->first;
+  const auto after = std::find_if(g_rec.odometry.begin(), g_rec.odometry.end(),
+                                  [&](const auto& o) { return o.first >= reset_at; });
+  ASSERT_NE(after, g_rec.odometry.end()) << "no odometry after the reset: it did not track again";
+  EXPECT_EQ(g_rec.latestStatus().state, alvio::PipelineStatus::TRACKING);
+
+  // The model on what was published: a reset is counted before its frame's pose.
+  alvio::OdometryCovariance model(options);
+  std::size_t next_reset = 0;
+  for (std::size_t i = 0; i < g_rec.odometry.size(); ++i) {
+    const auto& [stamp, pose] = g_rec.odometry[i];
+    for (; next_reset < resets.size() && resets[next_reset].first <= stamp; ++next_reset)
+      for (int r = 0; r < resets[next_reset].second; ++r) model.addEstimatorReset();
+    model.addPosition(pose.p);
+    const alvio::Covariance6 expected = model.pose();
+    for (int d = 0; d < 6; ++d)
+      ASSERT_NEAR(g_rec.pose_covariance[i][d * 7], expected[d * 7], 1e-9 * expected[d * 7])
+          << "odometry " << i << " (" << (stamp - first_odometry) * 1e-9
+          << " s after the first), diagonal " << d << "; " << model.resets()
+          << " resets counted after the first output";
+  }
+
+  // And in plain numbers: the position's variance jumps by at least the reset's at the reset.
+  const std::size_t a = static_cast<std::size_t>(after - g_rec.odometry.begin());
+  ASSERT_GT(a, 0u);
+  const double before_sigma = std::sqrt(g_rec.pose_covariance[a - 1][0]);
+  const double after_sigma = std::sqrt(g_rec.pose_covariance[a][0]);
+  std::cout << "reset at " << (reset_at - first_odometry) * 1e-9
+            << " s after the first odometry; odometry again " << (after->first - reset_at) * 1e-9
+            << " s later; position sigma " << before_sigma << " -> " << after_sigma
+            << " m (reset sigma " << options.reset_position_sigma_m << " m)\n";
+  EXPECT_GE(after_sigma * after_sigma,
+            before_sigma * before_sigma + 0.999 * std::pow(options.reset_position_sigma_m, 2));
+}
+
 int main(int argc, char** argv) {
   testing::InitGoogleTest(&argc, argv);
   ros::init(argc, argv, "alvio_pipeline_check");
@@ -500,13 +575,15 @@ int main(int argc, char** argv) {
   pnh.getParam("check_reload", s.check_reload);
   pnh.getParam("check_zero_copy", s.check_zero_copy);
   pnh.getParam("replay", s.replay);
+  pnh.getParam("bag", s.bag);
+  pnh.getParam("expect_reset", s.expect_reset);
   std::string image_topic = "/cam0/image_raw";
   pnh.getParam("image_topic", image_topic);
   if (fs::exists(s.data_dir + "/UNAVAILABLE")) {
     std::ifstream in(s.data_dir + "/UNAVAILABLE");
     std::getline(in, g_unavailable);
-  } else if (!fs::exists(s.data_dir + "/sim.bag")) {
-    g_unavailable = s.data_dir + "/sim.bag is missing";
+  } else if (!fs::exists(s.data_dir + "/" + s.bag)) {
+    g_unavailable = s.data_dir + "/" + s.bag + " is missing";
   }
 
   auto onImage = [](const sensor_msgs::ImageConstPtr& m) {
