@@ -22,7 +22,8 @@ the estimator nodelet's odometry message:
 It prints each run's errors, then the sigmas fitted over all runs: the angular rate's RMS per
 axis (a gyroscope on a vibrating body is noisier on some axes), velocity and tilt the largest
 per-axis RMS, position and yaw the least-squares fit of e^2 = s0^2 + (k d)^2 + n r^2 (d the
-path, n the resets before the pose; r is fitted only when the runs have a reset). With
+path, n the resets before the pose; r is fitted only when the runs have a reset), and per
+reset the error's jump across it against the outage the IMU's dead reckoning bridged. With
 --config it also prints how often that configuration's model holds each error within 1 and 2
 sigma (a Gaussian: 68 % and 95 %), to check sigmas on runs that did not set them.
 """
@@ -113,7 +114,7 @@ def run_errors(run, dataset):
     Rm = quat_to_matrix(interpolate_quaternions(np.clip(t - h, t_gt[0], t_gt[-1]), t_gt, q_gt_all))
     rate_gt = rotation_log(np.einsum("nji,njk->nik", Rm, Rp)) / (2 * h)
     rate_err = gyro - states[:, 7:10] - rate_gt
-    return {"path": path, "resets": resets, "position": p_est - p_gt, "yaw": rot_err[:, 2],
+    return {"t": t, "path": path, "resets": resets, "position": p_est - p_gt, "yaw": rot_err[:, 2],
             "tilt": rot_err[:, :2], "velocity": v_body - v_body_gt, "rate": rate_err}
 
 
@@ -132,6 +133,17 @@ def load_reset_times(path):
             except ValueError:
                 fail(f"{path}:{number}: a reset without a time: {line!r}")
     return np.sort(np.array(times))
+
+
+def reset_jumps(errors):
+    """Per reset after the first pose: (s after the first pose, outage: s from the last pose
+    before it to the first after, the position error's jump (m), the yaw error's (deg)). The
+    outage is what the IMU's dead reckoning bridged."""
+    t, n = errors["t"], errors["resets"]
+    after = np.flatnonzero(np.diff(n) > 0) + 1
+    return [(t[i] - t[0], t[i] - t[i - 1],
+             float(np.linalg.norm(errors["position"][i] - errors["position"][i - 1])),
+             float(errors["yaw"][i] - errors["yaw"][i - 1])) for i in after]
 
 
 def rms(x, axis=0):
@@ -270,6 +282,14 @@ def main():
         v = fitted[k]
         print(f"  {k}: " + (f"[{', '.join(f'{x:.4g}' for x in v)}]" if isinstance(v, list)
                             else f"{v:.4g}"))
+    if any_reset:
+        print("\nThe resets: the error's jump across each, against how long the IMU's dead "
+              "reckoning bridged\n\n| run | reset at (s after the first pose) | outage (s) | "
+              "position error's jump (m) | yaw error's jump (deg) |\n|---|---|---|---|---|")
+        for spec, e in zip(args.runs, all_errors):
+            for at, outage, dp, dyaw in reset_jumps(e):
+                print(f"| {spec.split(':', 1)[0]} | {at:.2f} | {outage:.2f} | {dp:.4f} | "
+                      f"{dyaw:+.3f} |")
     if not any_reset:
         print(f"\n{' and '.join(RESET_KEYS)}: not fitted, as no run has a reset of the estimator "
               "(keep your configuration's)")

@@ -36,6 +36,7 @@ RATE_SIGMA = GYRO_SIGMA * np.hypot(0.8, 0.2)
 RESET_TIMES_S = (40.0, 90.0, 150.0)   # after the start, in the run with resets
 RESET_POSITION_SIGMA = 0.05           # m per axis, added in quadrature per reset
 RESET_YAW_SIGMA_DEG = 0.3
+OUTAGE_S = 1.5                        # no output pose for this long before each reset
 
 
 def rot_z(a):
@@ -57,7 +58,8 @@ def small_rotation(v):
 
 
 def make_run(folder, seed, resets=()):
-    """A run in folder/run on the dataset folder/data; resets: their times after the start."""
+    """A run in folder/run on the dataset folder/data; resets: their times after the start,
+    each after OUTAGE_S without output (the estimator lost, then initialising again)."""
     rng = np.random.default_rng(seed)
     n = int(DURATION_S * RATE_HZ) + 1
     t_ns = 1_600_000_000_000_000_000 + np.arange(n, dtype=np.int64) * (10**9 // RATE_HZ)
@@ -83,6 +85,7 @@ def make_run(folder, seed, resets=()):
                delimiter=",", fmt=["%d"] + ["%.12f"] * 6, header="timestamp,...")
     # The estimate at the camera's stamps, 1 ms before an IMU sample (as the IMU runs ahead).
     k = np.arange(CAMERA_EVERY, n - CAMERA_EVERY, CAMERA_EVERY)
+    k = k[[not any(r - OUTAGE_S <= t[i] - 0.001 < r for r in resets) for i in k]]
     tc = t[k] - 0.001
     stamps = t_ns[k] * 1e-9 - 0.001
     path = SPEED * (tc - tc[0])
@@ -197,6 +200,32 @@ class OdometryErrorTest(CleanFailureAssertions, unittest.TestCase):
         self.assertAlmostEqual(got["position_drift"], POSITION_DRIFT, delta=0.05 * POSITION_DRIFT)
         self.assertAlmostEqual(got["yaw_drift_deg_per_m"], YAW_DRIFT_DEG_PER_M,
                                delta=0.05 * YAW_DRIFT_DEG_PER_M)
+
+    def test_each_resets_jump_is_told_with_its_outage(self):
+        p = run_script(f"{self.reset_run}:{self.reset_data}")
+        self.assertEqual(p.returncode, 0, p.stderr)
+        table = p.stdout.split("| run | reset at (s after the first pose) |", 1)[1]
+        rows = [line.split("|")[1:-1] for line in table.splitlines()
+                if line.startswith(f"| {self.reset_run} |")]
+        self.assertEqual(len(rows), len(RESET_TIMES_S))
+        first_pose = CAMERA_EVERY / RATE_HZ - 0.001  # after the start
+        for n, (row, at) in enumerate(zip(rows, RESET_TIMES_S), 1):
+            reset_at, outage, dp, dyaw = (float(x) for x in row[1:])
+            # The first pose after the reset: the camera's next stamp.
+            self.assertAlmostEqual(reset_at, at - first_pose, delta=1.01 * CAMERA_EVERY / RATE_HZ)
+            self.assertAlmostEqual(outage, OUTAGE_S, delta=1.01 * CAMERA_EVERY / RATE_HZ)
+            # The error on each axis goes from sqrt((k d)^2 + (n-1) r^2) to sqrt(... + n r^2):
+            # the path's part barely moves across the outage (1.5 m of 40-150 m).
+            d_before, d_after = SPEED * (at - OUTAGE_S), SPEED * at
+            want = np.sqrt(3) * (np.sqrt((POSITION_DRIFT * d_after) ** 2 +
+                                         n * RESET_POSITION_SIGMA ** 2) -
+                                 np.sqrt((POSITION_DRIFT * d_before) ** 2 +
+                                         (n - 1) * RESET_POSITION_SIGMA ** 2))
+            self.assertAlmostEqual(dp, want, delta=0.002, msg=f"reset {n}")
+            self.assertGreater(dyaw, 0.0, f"reset {n}")
+        # A run without resets has no such table.
+        p = run_script(f"{self.run_dir}:{self.data}")
+        self.assertNotIn("reset at (s after the first pose)", p.stdout)
 
     def test_a_model_without_reset_sigmas_misses_the_poses_after_a_reset(self):
         rows = {}
