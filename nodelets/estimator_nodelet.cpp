@@ -245,7 +245,6 @@ class EstimatorNodelet : public GuardedNodelet {
     const int resets_before = estimator_->resetCount();
     const bool has_pose = estimator_->addFrame(fromMsg(features));
     const std::vector<alvio::EstimatorEvent> events = estimator_->takeEvents();
-    for (int r = resets_before; r < estimator_->resetCount(); ++r) covariance_->addEstimatorReset();
     const alvio::LineSegments3 retired = estimator_->takeRetiredLines();
     const double estimator_ms =
         std::chrono::duration<double, std::milli>(Clock::now() - start).count();
@@ -306,7 +305,7 @@ class EstimatorNodelet : public GuardedNodelet {
     odometry->twist.twist.angular.x = w_b.x();
     odometry->twist.twist.angular.y = w_b.y();
     odometry->twist.twist.angular.z = w_b.z();
-    covariance_->addPosition(state.p);
+    covariance_->addPose(state.t, state.p);  // a pause since the last one is an outage
     // A calibrated error model (config odometry_covariance), not the window's marginal.
     const alvio::Covariance6 pose_cov = covariance_->pose(), twist_cov = covariance_->twist();
     std::copy(pose_cov.begin(), pose_cov.end(), odometry->pose.covariance.begin());

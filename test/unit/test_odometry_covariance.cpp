@@ -36,12 +36,13 @@ TEST(OdometryCovariance, PositionAndYawGrowWithThePathTiltAndTwistDoNot) {
   OdometryCovariance model(o);
   const double tilt = std::pow(0.2 * kDeg, 2);
   // Before any motion: the sigmas at the start.
-  model.addPosition(Eigen::Vector3d(1, 2, 3));
+  model.addPose(0.0, Eigen::Vector3d(1, 2, 3));
   expectDiagonal(model.pose(), {9e-4, 9e-4, 9e-4, tilt, tilt, std::pow(kDeg, 2)});
   // 100 m along a square's sides and back: the path counts, not the distance from the start.
+  double t = 0.0;
   for (const Eigen::Vector3d& p : {Eigen::Vector3d(26, 2, 3), Eigen::Vector3d(26, 27, 3),
                                    Eigen::Vector3d(1, 27, 3), Eigen::Vector3d(1, 2, 3)})
-    model.addPosition(p);
+    model.addPose(t += 0.05, p);
   EXPECT_NEAR(model.pathLength(), 100.0, 1e-12);
   const double position = 0.03 * 0.03 + 0.2 * 0.2;  // 0.002 m/m over 100 m
   const double yaw = (1.0 + 1.0) * kDeg * kDeg;     // 0.01 deg/m over 100 m
@@ -49,43 +50,61 @@ TEST(OdometryCovariance, PositionAndYawGrowWithThePathTiltAndTwistDoNot) {
   expectDiagonal(model.twist(), {1e-4, 1e-4, 1e-4, 6.25e-6, 2.5e-5, 1.6e-5});
   // A new run starts its path again; a non-finite position is not a step.
   model.startNewRun();
-  model.addPosition(Eigen::Vector3d(50, 0, 0));
-  model.addPosition(Eigen::Vector3d(NAN, 0, 0));
-  model.addPosition(Eigen::Vector3d(53, 4, 0));
+  model.addPose(0.0, Eigen::Vector3d(50, 0, 0));
+  model.addPose(0.05, Eigen::Vector3d(NAN, 0, 0));
+  model.addPose(0.1, Eigen::Vector3d(53, 4, 0));
   EXPECT_NEAR(model.pathLength(), 5.0, 1e-12);
 }
 
-TEST(OdometryCovariance, EachEstimatorResetWidensPositionAndYawUntilANewRun) {
+TEST(OdometryCovariance, EachOutageWidensPositionAndYawByItsLengthUntilANewRun) {
   OdometryCovarianceOptions o = someOptions();
-  o.reset_position_sigma_m = 0.05;
-  o.reset_yaw_sigma_deg = 0.5;
+  o.outage_min_s = 0.3;
+  o.outage_position_sigma_mps = 0.01;
+  o.outage_position_sigma_mps2 = 0.004;
+  o.outage_yaw_sigma_deg_per_s = 0.02;
   OdometryCovariance model(o);
-  model.addEstimatorReset();  // while initialising: no output yet to carry its error
-  EXPECT_EQ(model.resets(), 0);
-  model.addPosition(Eigen::Vector3d(0, 0, 0));
-  model.addPosition(Eigen::Vector3d(50, 0, 0));
+  // 50 m with pauses of 0.25 s (under outage_min_s): no outage yet. Binary-exact stamps.
+  model.addPose(10.0, Eigen::Vector3d(0, 0, 0));
+  model.addPose(10.25, Eigen::Vector3d(25, 0, 0));
+  model.addPose(10.5, Eigen::Vector3d(50, 0, 0));
+  EXPECT_EQ(model.outages(), 0);
   const double tilt = std::pow(0.2 * kDeg, 2);
   const double position = 0.03 * 0.03 + 0.1 * 0.1;  // 0.002 m/m over 50 m
   const double yaw = (1.0 + 0.25) * kDeg * kDeg;    // 0.01 deg/m over 50 m
   expectDiagonal(model.pose(), {position, position, position, tilt, tilt, yaw});
-  // Two resets: each adds its variance; tilt is gravity's and the twist is the IMU's.
-  model.addEstimatorReset();
-  model.addEstimatorReset();
-  EXPECT_EQ(model.resets(), 2);
-  const double position2 = position + 2 * 0.05 * 0.05, yaw2 = yaw + 2 * 0.25 * kDeg * kDeg;
+  // Outages of 3 s and 1 s (no step): (a T)^2 + (b T^2)^2 each on position, (c T)^2 on yaw;
+  // tilt is gravity's and the twist is the IMU's.
+  model.addPose(13.5, Eigen::Vector3d(50, 0, 0));
+  model.addPose(14.5, Eigen::Vector3d(50, 0, 0));
+  EXPECT_EQ(model.outages(), 2);
+  const double outages = std::pow(0.01 * 3, 2) + std::pow(0.004 * 9, 2) +  // 3 s
+                         std::pow(0.01 * 1, 2) + std::pow(0.004 * 1, 2);   // 1 s
+  const double position2 = position + outages;
+  const double yaw2 = yaw + (std::pow(0.02 * 3, 2) + std::pow(0.02 * 1, 2)) * kDeg * kDeg;
   expectDiagonal(model.pose(), {position2, position2, position2, tilt, tilt, yaw2});
   expectDiagonal(model.twist(), {1e-4, 1e-4, 1e-4, 6.25e-6, 2.5e-5, 1.6e-5});
-  // The resets stay with the run: its output is still re-anchored on the dead reckoning.
-  model.addPosition(Eigen::Vector3d(50, 30, 0));
-  const double position3 = 0.03 * 0.03 + 0.16 * 0.16 + 2 * 0.05 * 0.05;
-  EXPECT_NEAR(model.pose()[0], position3, 1e-15);
-  // A new run starts from its own origin: no reset behind it.
+  // The outages stay with the run: its output still carries their error.
+  model.addPose(14.75, Eigen::Vector3d(50, 30, 0));
+  EXPECT_NEAR(model.pose()[0], 0.03 * 0.03 + 0.16 * 0.16 + outages, 1e-15);
+  // A new run starts from its own origin: the gap from the old run's last pose is no outage.
   model.startNewRun();
-  EXPECT_EQ(model.resets(), 0);
-  model.addEstimatorReset();
-  EXPECT_EQ(model.resets(), 0) << "a reset before the new run's first output";
-  model.addPosition(Eigen::Vector3d(0, 0, 0));
+  EXPECT_EQ(model.outages(), 0);
+  model.addPose(100.0, Eigen::Vector3d(0, 0, 0));
+  EXPECT_EQ(model.outages(), 0);
   expectDiagonal(model.pose(), {9e-4, 9e-4, 9e-4, tilt, tilt, std::pow(kDeg, 2)});
+}
+
+TEST(OdometryCovariance, TheResetKeysItReplacedAreNamed) {
+  for (const char* key : {"reset_position_sigma_m", "reset_yaw_sigma_deg"}) {
+    const YamlReader yaml = YamlReader::fromString(
+        std::string("odometry_covariance:\n  ") + key + ": 0.07\n", "robot.yaml");
+    const std::string error =
+        test::errorOf([&] { OdometryCovarianceOptions::load(yaml, "odometry_covariance"); });
+    EXPECT_NE(error.find(std::string("robot.yaml: odometry_covariance.") + key +
+                         " was replaced by outage_position_sigma_mps"),
+              std::string::npos)
+        << error;
+  }
 }
 
 TEST(OdometryCovariance, ReadsItsSectionAndNamesABadKey) {
@@ -95,8 +114,9 @@ TEST(OdometryCovariance, ReadsItsSectionAndNamesABadKey) {
   EXPECT_DOUBLE_EQ(o.position_drift, 0.004);
   EXPECT_EQ(o.velocity_sigma_mps, Eigen::Vector3d::Constant(0.05));  // one number: all axes
   EXPECT_DOUBLE_EQ(o.tilt_sigma_deg, OdometryCovarianceOptions().tilt_sigma_deg);
-  for (const char* key : {"position_sigma_m", "yaw_drift_deg_per_m", "reset_position_sigma_m",
-                          "reset_yaw_sigma_deg", "angular_rate_sigma_rps"}) {
+  for (const char* key :
+       {"position_sigma_m", "yaw_drift_deg_per_m", "outage_min_s", "outage_position_sigma_mps",
+        "outage_position_sigma_mps2", "outage_yaw_sigma_deg_per_s", "angular_rate_sigma_rps"}) {
     const YamlReader bad = YamlReader::fromString(
         std::string("odometry_covariance:\n  ") + key + ": -0.1\n", "robot.yaml");
     const std::string error =
