@@ -12,8 +12,9 @@ the estimator nodelet's odometry message:
 - position and yaw relative to where the odometry started: both trajectories are put on the
   first output pose (position and yaw; roll and pitch are gravity's), so the error is the
   drift since then, against the path travelled (the truth's; the nodelet counts its own
-  output's, which differs by the scale error, a few per cent) and the estimator's resets so
-  far (events.log): after each, the output goes on from the IMU's dead reckoning;
+  output's, which differs by the scale error, a few per cent) and the outages so far: pauses
+  in the output longer than outage_min_s (0.3 s, or the --config's), bridged by the IMU's
+  dead reckoning (images missing, tracking lost, a reset: events.log says which);
 - tilt: the orientation's error about the world's x and y axes (gravity's direction);
 - velocity in the body frame (R^T v), which no alignment changes;
 - angular rate: the gyroscope interpolated at the frame's stamp less the estimated bias (what
@@ -21,9 +22,10 @@ the estimator nodelet's odometry message:
 
 It prints each run's errors, then the sigmas fitted over all runs: the angular rate's RMS per
 axis (a gyroscope on a vibrating body is noisier on some axes), velocity and tilt the largest
-per-axis RMS, position and yaw the least-squares fit of e^2 = s0^2 + (k d)^2 + n r^2 (d the
-path, n the resets before the pose; r is fitted only when the runs have a reset), and per
-reset the error's jump across it against the outage the IMU's dead reckoning bridged. With
+per-axis RMS, position and yaw the least-squares fits, all terms >= 0, of
+e^2 = s0^2 + (k d)^2 + sum over the outages before the pose of (a T)^2 + (b T^2)^2 (yaw: (c T)^2),
+d the path and T each outage's length (a, b, c are fitted only when the runs have an outage),
+and per outage the error's jump across it. With
 --config it also prints how often that configuration's model holds each error within 1 and 2
 sigma (a Gaussian: 68 % and 95 %), to check sigmas on runs that did not set them.
 """
@@ -38,9 +40,14 @@ import imu_noise  # scripts/, beside this one
 from imu_noise import quat_to_matrix, rotation_log
 
 KEYS = ("position_sigma_m", "position_drift", "tilt_sigma_deg", "yaw_sigma_deg",
-        "yaw_drift_deg_per_m", "reset_position_sigma_m", "reset_yaw_sigma_deg",
+        "yaw_drift_deg_per_m", "outage_min_s", "outage_position_sigma_mps",
+        "outage_position_sigma_mps2", "outage_yaw_sigma_deg_per_s",
         "velocity_sigma_mps", "angular_rate_sigma_rps")
-RESET_KEYS = ("reset_position_sigma_m", "reset_yaw_sigma_deg")
+OUTAGE_KEYS = ("outage_position_sigma_mps", "outage_position_sigma_mps2",
+               "outage_yaw_sigma_deg_per_s")
+OUTAGE_MIN_S = 0.3  # alvio's default outage_min_s
+# Keys of the sixty-sixth session's constant per reset, which alvio no longer reads.
+REPLACED_KEYS = ("reset_position_sigma_m", "reset_yaw_sigma_deg")
 # Sigmas of the body-frame twist: one number for all three axes or a list of three (x, y, z).
 PER_AXIS_KEYS = ("velocity_sigma_mps", "angular_rate_sigma_rps")
 
@@ -68,8 +75,9 @@ def interpolate_quaternions(t_query, t, q):
     return out / np.linalg.norm(out, axis=1, keepdims=True)
 
 
-def run_errors(run, dataset):
-    """The errors of one run's output poses (dict of arrays) and the path at each pose."""
+def run_errors(run, dataset, outage_min_s=OUTAGE_MIN_S):
+    """The errors of one run's output poses (dict of arrays), and at each pose the path, the
+    outages so far (count, sums of T^2 and T^4) and the resets so far."""
     run, dataset = Path(run), Path(dataset)
     est = load_table(run / "trajectory.tum", TUM_COLUMNS)
     states = load_table(run / "states.csv", STATES_COLUMNS, delimiter=",", header=1)
@@ -106,6 +114,9 @@ def run_errors(run, dataset):
     rot_err = np.degrees(rotation_log(np.einsum("ij,njk,nlk->nil", Rz, R_est, R_gt)))
     path = np.concatenate([[0], np.cumsum(np.linalg.norm(np.diff(p_gt, axis=0), axis=1))])
     resets = np.searchsorted(reset_times, t, side="right")  # resets at or before each pose
+    gap = np.concatenate([[0.0], np.diff(t)])
+    gap[gap <= outage_min_s] = 0.0
+    outages, outage_s2, outage_s4 = np.cumsum(gap > 0), np.cumsum(gap ** 2), np.cumsum(gap ** 4)
     # Angular rate: the gyroscope interpolated at the frame's stamp, less the estimated bias
     # (Estimator::gyroAtLatestFrame; np.interp holds the last sample as the estimator does).
     gyro = np.stack([np.interp(t, t_imu, imu[:, 1 + k]) for k in range(3)], 1)
@@ -114,7 +125,8 @@ def run_errors(run, dataset):
     Rm = quat_to_matrix(interpolate_quaternions(np.clip(t - h, t_gt[0], t_gt[-1]), t_gt, q_gt_all))
     rate_gt = rotation_log(np.einsum("nji,njk->nik", Rm, Rp)) / (2 * h)
     rate_err = gyro - states[:, 7:10] - rate_gt
-    return {"t": t, "path": path, "resets": resets, "position": p_est - p_gt, "yaw": rot_err[:, 2],
+    return {"t": t, "path": path, "resets": resets, "outages": outages, "outage_s2": outage_s2,
+            "outage_s4": outage_s4, "position": p_est - p_gt, "yaw": rot_err[:, 2],
             "tilt": rot_err[:, :2], "velocity": v_body - v_body_gt, "rate": rate_err}
 
 
@@ -135,13 +147,12 @@ def load_reset_times(path):
     return np.sort(np.array(times))
 
 
-def reset_jumps(errors):
-    """Per reset after the first pose: (s after the first pose, outage: s from the last pose
-    before it to the first after, the position error's jump (m), the yaw error's (deg)). The
-    outage is what the IMU's dead reckoning bridged."""
-    t, n = errors["t"], errors["resets"]
+def outage_jumps(errors):
+    """Per outage: (s after the first pose, its length: s from the last pose before it to the
+    first after, resets in it, the position error's jump (m), the yaw error's (deg))."""
+    t, n = errors["t"], errors["outages"]
     after = np.flatnonzero(np.diff(n) > 0) + 1
-    return [(t[i] - t[0], t[i] - t[i - 1],
+    return [(t[i] - t[0], t[i] - t[i - 1], int(errors["resets"][i] - errors["resets"][i - 1]),
              float(np.linalg.norm(errors["position"][i] - errors["position"][i - 1])),
              float(errors["yaw"][i] - errors["yaw"][i - 1])) for i in after]
 
@@ -150,19 +161,21 @@ def rms(x, axis=0):
     return np.sqrt(np.mean(np.square(x), axis=axis))
 
 
-def fit_growth(errors_sq, path, resets):
-    """s0, k, r of e^2 = s0^2 + (k d)^2 + n r^2 by least squares on the squares, all >= 0.
+def fit_growth(errors_sq, *columns):
+    """The sigmas s of e^2 = sum s_j^2 x_j (x_j the columns) by least squares on the squares,
+    all >= 0.
 
-    With three unknowns the constrained optimum is the best unconstrained fit, over the
+    With a few unknowns the constrained optimum is the best unconstrained fit, over the
     subsets of the terms, whose coefficients are all >= 0."""
-    A = np.stack([np.ones_like(path), path ** 2, resets.astype(float)], 1)
+    A = np.stack(columns, 1)
+    m = A.shape[1]
     best = None
-    for subset in range(1, 8):
-        cols = [j for j in range(3) if subset >> j & 1]
+    for subset in range(1, 2 ** m):
+        cols = [j for j in range(m) if subset >> j & 1]
         coef, *_ = np.linalg.lstsq(A[:, cols], errors_sq, rcond=None)
         if np.any(coef < 0):
             continue
-        full = np.zeros(3)
+        full = np.zeros(m)
         full[cols] = coef
         residual = np.sum(np.square(A @ full - errors_sq))
         if best is None or residual < best[0]:
@@ -173,14 +186,17 @@ def fit_growth(errors_sq, path, resets):
 def fit(all_errors):
     e = {k: np.concatenate([r[k] for r in all_errors]) for k in all_errors[0]}
     n = len(e["path"])
-    s0 = fit_growth(np.square(e["position"]).reshape(-1), np.repeat(e["path"], 3),
-                    np.repeat(e["resets"], 3))
-    y0 = fit_growth(np.square(e["yaw"]), e["path"], e["resets"])
+    ones = np.ones_like(e["path"])
+    s0 = fit_growth(np.square(e["position"]).reshape(-1),
+                    *(np.repeat(x, 3) for x in (ones, e["path"] ** 2, e["outage_s2"],
+                                                e["outage_s4"])))
+    y0 = fit_growth(np.square(e["yaw"]), ones, e["path"] ** 2, e["outage_s2"])
     return {
         "position_sigma_m": s0[0], "position_drift": s0[1],
         "tilt_sigma_deg": float(np.max(rms(e["tilt"]))),
         "yaw_sigma_deg": y0[0], "yaw_drift_deg_per_m": y0[1],
-        "reset_position_sigma_m": s0[2], "reset_yaw_sigma_deg": y0[2],
+        "outage_position_sigma_mps": s0[2], "outage_position_sigma_mps2": s0[3],
+        "outage_yaw_sigma_deg_per_s": y0[2],
         "velocity_sigma_mps": float(np.max(rms(e["velocity"]))),
         "angular_rate_sigma_rps": [float(x) for x in rms(e["rate"])],
     }, n
@@ -202,11 +218,15 @@ def load_model(path):
         section.update(data.get("odometry_covariance") or {})
         return section
     section = read(path, frozenset())
+    replaced = [k for k in REPLACED_KEYS if k in section]
+    if replaced:
+        fail(f"{path}: odometry_covariance.{replaced[0]} was replaced by {', '.join(OUTAGE_KEYS)} "
+             "(an outage's error grows with its length; fit them with this script)")
     unknown = sorted(set(section) - set(KEYS))
     if unknown:
         fail(f"{path}: unknown key odometry_covariance.{unknown[0]}")
-    # A configuration from before the reset keys widens nothing after a reset, as in alvio.
-    section = {**{k: 0.0 for k in RESET_KEYS}, **section}
+    # A configuration from before the outage keys widens nothing after one, as in alvio.
+    section = {**{k: 0.0 for k in OUTAGE_KEYS}, "outage_min_s": OUTAGE_MIN_S, **section}
     missing = [k for k in KEYS if k not in section]
     if missing:
         fail(f"{path}: odometry_covariance.{missing[0]} is not set (give every key to check it)")
@@ -229,11 +249,13 @@ def model_value(path, key, value):
 
 def coverage(model, errors):
     """Fraction of each component's errors within 1 and 2 of the model's sigmas."""
-    d, n = errors["path"], errors["resets"]
+    d, n = errors["path"], errors["outages"]
+    s2, s4 = errors["outage_s2"], errors["outage_s4"]
     sp = np.sqrt(model["position_sigma_m"] ** 2 + (model["position_drift"] * d) ** 2 +
-                 n * model["reset_position_sigma_m"] ** 2)
+                 model["outage_position_sigma_mps"] ** 2 * s2 +
+                 model["outage_position_sigma_mps2"] ** 2 * s4)
     sy = np.sqrt(model["yaw_sigma_deg"] ** 2 + (model["yaw_drift_deg_per_m"] * d) ** 2 +
-                 n * model["reset_yaw_sigma_deg"] ** 2)
+                 model["outage_yaw_sigma_deg_per_s"] ** 2 * s2)
     # Normalised errors, one per axis and pose.
     parts = {
         "position": np.abs(errors["position"]) / sp[:, None],
@@ -242,10 +264,10 @@ def coverage(model, errors):
         "velocity": np.abs(errors["velocity"]) / model["velocity_sigma_mps"],
         "angular rate": np.abs(errors["rate"]) / model["angular_rate_sigma_rps"],
     }
-    # The poses after a reset on their own: the few that the reset sigmas are for.
+    # The poses after an outage on their own: the few that the outage sigmas are for.
     if np.any(n > 0):
-        parts["position after a reset"] = parts["position"][n > 0]
-        parts["yaw after a reset"] = parts["yaw"][n > 0]
+        parts["position after an outage"] = parts["position"][n > 0]
+        parts["yaw after an outage"] = parts["yaw"][n > 0]
     # The twist per axis too: which axis a single sigma misfits, or a per-axis one still does.
     for name in ("velocity", "angular rate"):
         for axis, label in enumerate("xyz"):
@@ -256,45 +278,48 @@ def coverage(model, errors):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("runs", nargs="+", metavar="RUN:DATASET")
-    ap.add_argument("--config", help="check this configuration's odometry_covariance sigmas")
+    ap.add_argument("--config", help="check this configuration's odometry_covariance sigmas "
+                    "(its outage_min_s also says what an outage is)")
     args = ap.parse_args()
+    model = load_model(args.config) if args.config else None
+    outage_min_s = model["outage_min_s"] if model else OUTAGE_MIN_S
     all_errors = []
-    print("| run | poses | path (m) | resets | position at the end (m) | yaw RMS (deg) | "
-          "tilt RMS, larger axis (deg) | velocity RMS x/y/z (m/s) | "
+    print("| run | poses | path (m) | outages | resets | position at the end (m) | "
+          "yaw RMS (deg) | tilt RMS, larger axis (deg) | velocity RMS x/y/z (m/s) | "
           "angular rate RMS x/y/z (rad/s) |")
-    print("|---|---|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     for spec in args.runs:
         if ":" not in spec:
             fail(f"'{spec}' is not RUN:DATASET")
         run, dataset = spec.split(":", 1)
-        e = run_errors(run, dataset)
+        e = run_errors(run, dataset, outage_min_s)
         all_errors.append(e)
-        print(f"| {run} | {len(e['path'])} | {e['path'][-1]:.1f} | {e['resets'][-1]} | "
-              f"{np.linalg.norm(e['position'][-1]):.3f} | {rms(e['yaw']):.3f} | "
-              f"{np.max(rms(e['tilt'])):.3f} | {' / '.join(f'{x:.4f}' for x in rms(e['velocity']))} | "
-              f"{' / '.join(f'{x:.4f}' for x in rms(e['rate']))} |")
+        velocity = " / ".join(f"{x:.4f}" for x in rms(e["velocity"]))
+        rate = " / ".join(f"{x:.4f}" for x in rms(e["rate"]))
+        print(f"| {run} | {len(e['path'])} | {e['path'][-1]:.1f} | {e['outages'][-1]} | "
+              f"{e['resets'][-1]} | {np.linalg.norm(e['position'][-1]):.3f} | "
+              f"{rms(e['yaw']):.3f} | {np.max(rms(e['tilt'])):.3f} | {velocity} | {rate} |")
     fitted, n = fit(all_errors)
     print(f"\nFitted over {len(all_errors)} run(s), {n} poses:\n\nodometry_covariance:")
-    any_reset = any(e["resets"][-1] > 0 for e in all_errors)
+    any_outage = any(e["outages"][-1] > 0 for e in all_errors)
     for k in KEYS:
-        if k in RESET_KEYS and not any_reset:
-            continue  # nothing to fit them on: noted below
+        if k == "outage_min_s" or (k in OUTAGE_KEYS and not any_outage):
+            continue  # a setting, not fitted; nothing to fit them on: noted below
         v = fitted[k]
         print(f"  {k}: " + (f"[{', '.join(f'{x:.4g}' for x in v)}]" if isinstance(v, list)
                             else f"{v:.4g}"))
-    if any_reset:
-        print("\nThe resets: the error's jump across each, against how long the IMU's dead "
-              "reckoning bridged\n\n| run | reset at (s after the first pose) | outage (s) | "
-              "position error's jump (m) | yaw error's jump (deg) |\n|---|---|---|---|---|")
+    if any_outage:
+        print(f"\nThe outages (pauses in the output over {outage_min_s:g} s): the error's jump "
+              "across each\n\n| run | outage at (s after the first pose) | outage (s) | resets | "
+              "position error's jump (m) | yaw error's jump (deg) |\n|---|---|---|---|---|---|")
         for spec, e in zip(args.runs, all_errors):
-            for at, outage, dp, dyaw in reset_jumps(e):
-                print(f"| {spec.split(':', 1)[0]} | {at:.2f} | {outage:.2f} | {dp:.4f} | "
-                      f"{dyaw:+.3f} |")
-    if not any_reset:
-        print(f"\n{' and '.join(RESET_KEYS)}: not fitted, as no run has a reset of the estimator "
-              "(keep your configuration's)")
-    if args.config:
-        model = load_model(args.config)
+            for at, length, resets, dp, dyaw in outage_jumps(e):
+                print(f"| {spec.split(':', 1)[0]} | {at:.2f} | {length:.2f} | {resets} | "
+                      f"{dp:.4f} | {dyaw:+.3f} |")
+    else:
+        print(f"\n{', '.join(OUTAGE_KEYS)}: not fitted, as no run has an outage (a pause in the "
+              f"output over {outage_min_s:g} s; keep your configuration's)")
+    if model:
         pooled = {k: np.concatenate([r[k] for r in all_errors]) for k in all_errors[0]}
         print(f"\n{args.config}'s sigmas: share of errors within 1 and 2 sigma "
               "(a Gaussian: 68 % / 95 %)\n")

@@ -3,8 +3,8 @@
 proportion to the path, tilt, body-frame velocity and gyroscope noise), written as alvio run
 writes trajectory.tum, states.csv and events.log. The fitted sigmas must give those sizes back,
 and a model with them must hold about 68 % and 95 % of Gaussian errors within 1 and 2 sigma.
-A second run has resets of the estimator, each of which adds a known variance to position and
-yaw."""
+A second run has outages (pauses in the output, most with a reset of the estimator), each of
+which adds a variance of known growth with its length to position and yaw."""
 import json
 import os
 import subprocess
@@ -33,10 +33,11 @@ GYRO_SIGMA = np.array([0.002, 0.005, 0.003])  # rad/s per sample, per axis (as a
 # a sample at 200 Hz: weights 0.8 and 0.2 on the samples around it, so less noise than one.
 # The sample after the stamp (what the nodelet published before) would give GYRO_SIGMA.
 RATE_SIGMA = GYRO_SIGMA * np.hypot(0.8, 0.2)
-RESET_TIMES_S = (40.0, 90.0, 150.0)   # after the start, in the run with resets
-RESET_POSITION_SIGMA = 0.05           # m per axis, added in quadrature per reset
-RESET_YAW_SIGMA_DEG = 0.3
-OUTAGE_S = 1.5                        # no output pose for this long before each reset
+# The run with outages: (when the output comes back, s after the start; the outage's length, s;
+# whether the estimator reset in it).
+OUTAGES = ((40.0, 1.0, True), (90.0, 3.0, True), (120.0, 2.0, False), (150.0, 6.0, True))
+# Per outage of T s, added in quadrature: (a T)^2 + (b T^2)^2 per position axis, (c T)^2 on yaw.
+OUTAGE_A, OUTAGE_B, OUTAGE_C = 0.01, 0.004, 0.05  # m/s, m/s^2, deg/s
 
 
 def rot_z(a):
@@ -57,9 +58,8 @@ def small_rotation(v):
     return np.eye(3) + np.sin(a) * K + (1 - np.cos(a)) * (K @ K)
 
 
-def make_run(folder, seed, resets=()):
-    """A run in folder/run on the dataset folder/data; resets: their times after the start,
-    each after OUTAGE_S without output (the estimator lost, then initialising again)."""
+def make_run(folder, seed, outages=()):
+    """A run in folder/run on the dataset folder/data, with these OUTAGES."""
     rng = np.random.default_rng(seed)
     n = int(DURATION_S * RATE_HZ) + 1
     t_ns = 1_600_000_000_000_000_000 + np.arange(n, dtype=np.int64) * (10**9 // RATE_HZ)
@@ -85,18 +85,23 @@ def make_run(folder, seed, resets=()):
                delimiter=",", fmt=["%d"] + ["%.12f"] * 6, header="timestamp,...")
     # The estimate at the camera's stamps, 1 ms before an IMU sample (as the IMU runs ahead).
     k = np.arange(CAMERA_EVERY, n - CAMERA_EVERY, CAMERA_EVERY)
-    k = k[[not any(r - OUTAGE_S <= t[i] - 0.001 < r for r in resets) for i in k]]
+    k = k[[not any(end - length <= t[i] - 0.001 < end for end, length, _ in outages) for i in k]]
     tc = t[k] - 0.001
     stamps = t_ns[k] * 1e-9 - 0.001
-    path = SPEED * (tc - tc[0])
-    # Position and yaw errors of exactly the model's size, sqrt((k d)^2 + n r^2): the fit is
-    # least squares, so it must give k and r back to the second-order effects of the noise.
-    n_resets = np.searchsorted(t[0] + np.array(resets), tc, side="right")
-    position_error = np.sqrt((POSITION_DRIFT * path) ** 2 + n_resets * RESET_POSITION_SIGMA ** 2)
-    yaw_error = np.sqrt((YAW_DRIFT_DEG_PER_M * path) ** 2 + n_resets * RESET_YAW_SIGMA_DEG ** 2)
+    pk = np.stack([RADIUS * np.cos(w * tc), RADIUS * np.sin(w * tc), 0.2 * np.sin(0.3 * tc)], 1)
+    # The path as the script measures it: through the output poses (across an outage, the
+    # chord of the circle flown).
+    path = np.concatenate([[0], np.cumsum(np.linalg.norm(np.diff(pk, axis=0), axis=1))])
+    # Position and yaw errors of exactly the model's size: the fit is least squares, so it must
+    # give the terms back to the second-order effects of the noise. T: the pause as measured.
+    gap = np.concatenate([[0.0], np.diff(tc)])
+    gap[gap <= 0.3] = 0.0
+    s2, s4 = np.cumsum(gap ** 2), np.cumsum(gap ** 4)
+    position_error = np.sqrt((POSITION_DRIFT * path) ** 2 + OUTAGE_A ** 2 * s2 +
+                             OUTAGE_B ** 2 * s4)
+    yaw_error = np.sqrt((YAW_DRIFT_DEG_PER_M * path) ** 2 + OUTAGE_C ** 2 * s2)
     # The estimate's own frame: a yaw and an offset the script must take out at its start.
     frame_yaw, frame_offset = 0.7, np.array([3.0, -2.0, 0.5])
-    pk = np.stack([RADIUS * np.cos(w * tc), RADIUS * np.sin(w * tc), 0.2 * np.sin(0.3 * tc)], 1)
     vk = np.stack([-SPEED * np.sin(w * tc), SPEED * np.cos(w * tc), 0.06 * np.cos(0.3 * tc)], 1)
     Rk = rot_z(w * tc + 1.0) @ tilt
     err_rot = np.column_stack([rng.normal(0, np.radians(TILT_SIGMA_DEG), (len(k), 2)),
@@ -121,9 +126,10 @@ def make_run(folder, seed, resets=()):
     start = t_ns[0] * 1e-9
     # A reset while initialising, before the first output pose, re-anchors nothing: the
     # script must not count it (nor does the nodelet).
-    early = [f"{stamps[0] - 0.5:.6f} reset initialisation failed\n"] if resets else []
+    early = [f"{stamps[0] - 0.5:.6f} reset initialisation failed\n"] if outages else []
     events = early + [f"{stamps[0]:.6f} initialized estimator ready\n"] + [
-        f"{start + r:.6f} reset tracking lost: too few features\n" for r in resets]
+        f"{start + end - length / 2:.6f} reset tracking lost: too few features\n"
+        for end, length, reset in outages if reset]
     (run / "events.log").write_text("".join(events))
     return run, folder / "data"
 
@@ -157,8 +163,8 @@ class OdometryErrorTest(CleanFailureAssertions, unittest.TestCase):
     def setUpClass(cls):
         cls.tmp = tempfile.TemporaryDirectory()
         cls.run_dir, cls.data = make_run(Path(cls.tmp.name), seed=3)
-        cls.reset_run, cls.reset_data = make_run(Path(cls.tmp.name) / "resets", seed=4,
-                                                 resets=RESET_TIMES_S)
+        cls.reset_run, cls.reset_data = make_run(Path(cls.tmp.name) / "outages", seed=4,
+                                                 outages=OUTAGES)
 
     @classmethod
     def tearDownClass(cls):
@@ -181,78 +187,92 @@ class OdometryErrorTest(CleanFailureAssertions, unittest.TestCase):
         self.assertEqual(len(got["angular_rate_sigma_rps"]), 3)
         for axis, (value, want) in enumerate(zip(got["angular_rate_sigma_rps"], RATE_SIGMA)):
             self.assertAlmostEqual(value, want, delta=0.1 * want, msg=f"angular rate axis {axis}")
-        # No reset to fit the reset sigmas on: they are left out, and the output says why.
-        self.assertNotIn("reset_position_sigma_m", got)
-        self.assertIn("reset_position_sigma_m and reset_yaw_sigma_deg: not fitted, as no run "
-                      "has a reset", p.stdout)
+        # No outage to fit the outage sigmas on: they are left out, and the output says why.
+        self.assertNotIn("outage_position_sigma_mps", got)
+        self.assertIn("outage_yaw_sigma_deg_per_s: not fitted, as no run has an outage",
+                      p.stdout)
 
-    def test_each_reset_adds_its_sigma_and_the_fit_gives_it_back(self):
+    def test_each_outage_adds_its_sigma_and_the_fit_gives_it_back(self):
         p = run_script(f"{self.reset_run}:{self.reset_data}", f"{self.run_dir}:{self.data}")
         self.assertEqual(p.returncode, 0, p.stderr)
-        self.assertIn(f"| {self.reset_run} | ", p.stdout)
-        self.assertIn(f" | {len(RESET_TIMES_S)} | ", p.stdout.split(str(self.reset_run), 1)[1])
+        row = p.stdout.split(f"| {self.reset_run} | ", 1)[1].split("\n", 1)[0].split(" | ")
+        self.assertEqual(int(row[2]), len(OUTAGES))  # outages
+        self.assertEqual(int(row[3]), sum(reset for *_, reset in OUTAGES))  # resets
         got = fitted(p.stdout)
-        self.assertAlmostEqual(got["reset_position_sigma_m"], RESET_POSITION_SIGMA,
-                               delta=0.05 * RESET_POSITION_SIGMA)
-        self.assertAlmostEqual(got["reset_yaw_sigma_deg"], RESET_YAW_SIGMA_DEG,
-                               delta=0.05 * RESET_YAW_SIGMA_DEG)
-        # The path's drift is still the path's, not taken by the resets.
+        for key, want in (("outage_position_sigma_mps", OUTAGE_A),
+                          ("outage_position_sigma_mps2", OUTAGE_B),
+                          ("outage_yaw_sigma_deg_per_s", OUTAGE_C)):
+            self.assertAlmostEqual(got[key], want, delta=0.05 * want, msg=key)
+        # The path's drift is still the path's, not taken by the outages.
         self.assertAlmostEqual(got["position_drift"], POSITION_DRIFT, delta=0.05 * POSITION_DRIFT)
         self.assertAlmostEqual(got["yaw_drift_deg_per_m"], YAW_DRIFT_DEG_PER_M,
                                delta=0.05 * YAW_DRIFT_DEG_PER_M)
 
-    def test_each_resets_jump_is_told_with_its_outage(self):
+    def test_each_outages_jump_is_told_with_its_length(self):
         p = run_script(f"{self.reset_run}:{self.reset_data}")
         self.assertEqual(p.returncode, 0, p.stderr)
-        table = p.stdout.split("| run | reset at (s after the first pose) |", 1)[1]
+        table = p.stdout.split("| run | outage at (s after the first pose) |", 1)[1]
         rows = [line.split("|")[1:-1] for line in table.splitlines()
                 if line.startswith(f"| {self.reset_run} |")]
-        self.assertEqual(len(rows), len(RESET_TIMES_S))
+        self.assertEqual(len(rows), len(OUTAGES))
         first_pose = CAMERA_EVERY / RATE_HZ - 0.001  # after the start
-        for n, (row, at) in enumerate(zip(rows, RESET_TIMES_S), 1):
-            reset_at, outage, dp, dyaw = (float(x) for x in row[1:])
-            # The first pose after the reset: the camera's next stamp.
-            self.assertAlmostEqual(reset_at, at - first_pose, delta=1.01 * CAMERA_EVERY / RATE_HZ)
-            self.assertAlmostEqual(outage, OUTAGE_S, delta=1.01 * CAMERA_EVERY / RATE_HZ)
-            # The error on each axis goes from sqrt((k d)^2 + (n-1) r^2) to sqrt(... + n r^2):
-            # the path's part barely moves across the outage (1.5 m of 40-150 m).
-            d_before, d_after = SPEED * (at - OUTAGE_S), SPEED * at
-            want = np.sqrt(3) * (np.sqrt((POSITION_DRIFT * d_after) ** 2 +
-                                         n * RESET_POSITION_SIGMA ** 2) -
-                                 np.sqrt((POSITION_DRIFT * d_before) ** 2 +
-                                         (n - 1) * RESET_POSITION_SIGMA ** 2))
-            self.assertAlmostEqual(dp, want, delta=0.002, msg=f"reset {n}")
-            self.assertGreater(dyaw, 0.0, f"reset {n}")
-        # A run without resets has no such table.
+        frame = 1.01 * CAMERA_EVERY / RATE_HZ
+        s2 = s4 = 0.0
+        for n, (row, (end, length, reset)) in enumerate(zip(rows, OUTAGES), 1):
+            at, measured, resets, dp, dyaw = (float(x) for x in row[1:])
+            # The first pose after the outage: the camera's next stamp.
+            self.assertAlmostEqual(at, end - first_pose, delta=frame)
+            self.assertAlmostEqual(measured, length, delta=frame)
+            self.assertEqual(resets, int(reset), f"outage {n}")
+            # The error on each axis goes from sqrt((k d)^2 + sum ...) to the same with this
+            # outage's (a T)^2 + (b T^2)^2 added; the path's part moves with the 1-6 m flown.
+            before = np.sqrt((POSITION_DRIFT * SPEED * (end - measured - first_pose)) ** 2 +
+                             OUTAGE_A ** 2 * s2 + OUTAGE_B ** 2 * s4)
+            s2, s4 = s2 + measured ** 2, s4 + measured ** 4
+            after = np.sqrt((POSITION_DRIFT * SPEED * (end - first_pose)) ** 2 + OUTAGE_A ** 2 * s2 +
+                            OUTAGE_B ** 2 * s4)
+            self.assertAlmostEqual(dp, np.sqrt(3) * (after - before), delta=0.002,
+                                   msg=f"outage {n}")
+            self.assertGreater(dyaw, 0.0, f"outage {n}")
+        # A run without outages has no such table.
         p = run_script(f"{self.run_dir}:{self.data}")
-        self.assertNotIn("reset at (s after the first pose)", p.stdout)
+        self.assertNotIn("outage at (s after the first pose)", p.stdout)
 
-    def test_a_model_without_reset_sigmas_misses_the_poses_after_a_reset(self):
+    def test_a_model_without_outage_sigmas_misses_the_poses_after_an_outage(self):
         rows = {}
-        # Without: a configuration from before the reset keys, read as no widening.
+        # Without: a configuration from before the outage keys, read as no widening.
         for name, scale in (("with", 1.0001), ("without", None)):
-            config = self.true_model(f"{name}_resets.yaml", reset_scale=scale)
+            config = self.true_model(f"{name}_outages.yaml", outage_scale=scale)
             p = run_script(f"{self.reset_run}:{self.reset_data}", "--config", config)
             self.assertEqual(p.returncode, 0, p.stderr)
             rows[name] = coverage(p.stdout)
-        for part in ("position after a reset", "yaw after a reset"):
+        for part in ("position after an outage", "yaw after an outage"):
             self.assertGreater(rows["with"][part][0], 98.0, part)
-            # Without them every pose after a reset is outside: its error is larger than the
+            # Without them every pose after an outage is outside: its error is larger than the
             # path's alone.
             self.assertLess(rows["without"][part][0], 2.0, part)
 
-    def true_model(self, name, reset_scale=1.0001):
-        """The sigmas the runs were made with, the drifts and resets just above them; with
-        reset_scale None, no reset keys at all (a configuration from before them)."""
+    def test_the_replaced_reset_keys_are_named(self):
+        config = Path(self.tmp.name) / "old_reset_keys.yaml"
+        config.write_text(self.true_model("base.yaml").read_text() +
+                          "  reset_position_sigma_m: 0.07\n")
+        self.assertFailsCleanly(
+            run_script(f"{self.run_dir}:{self.data}", "--config", config),
+            "odometry_covariance.reset_position_sigma_m was replaced by outage_position_sigma_mps")
+
+    def true_model(self, name, outage_scale=1.0001):
+        """The sigmas the runs were made with, the drifts and outages just above them; with
+        outage_scale None, no outage keys at all (a configuration from before them)."""
         config = Path(self.tmp.name) / name
         config.write_text(
             "odometry_covariance:\n"
             f"  position_sigma_m: 0.001\n  position_drift: {POSITION_DRIFT * 1.0001}\n"
             f"  tilt_sigma_deg: {TILT_SIGMA_DEG}\n  yaw_sigma_deg: 0.01\n"
             f"  yaw_drift_deg_per_m: {YAW_DRIFT_DEG_PER_M * 1.0001}\n"
-            + ("" if reset_scale is None else
-               f"  reset_position_sigma_m: {RESET_POSITION_SIGMA * reset_scale}\n"
-               f"  reset_yaw_sigma_deg: {RESET_YAW_SIGMA_DEG * reset_scale}\n")
+            + ("" if outage_scale is None else
+               f"  outage_position_sigma_mps: {OUTAGE_A * outage_scale}\n"
+               f"  outage_position_sigma_mps2: {OUTAGE_B * outage_scale}\n"
+               f"  outage_yaw_sigma_deg_per_s: {OUTAGE_C * outage_scale}\n")
             + f"  velocity_sigma_mps: {VELOCITY_SIGMA}\n"
             f"  angular_rate_sigma_rps: {json.dumps(RATE_SIGMA.tolist())}\n")
         return config
@@ -271,7 +291,7 @@ class OdometryErrorTest(CleanFailureAssertions, unittest.TestCase):
         # the second-order part of the tilt's noise in the yaw and the alignment.
         for name in ("position", "yaw"):
             self.assertGreater(rows[name][0], 98.0, name)
-        self.assertNotIn("position after a reset", rows)  # no reset in this run
+        self.assertNotIn("position after an outage", rows)  # no outage in this run
 
     def model_with_angular_rate(self, name, angular_rate):
         """A complete odometry_covariance section: 0.01 for every key but the angular rate."""
