@@ -123,7 +123,8 @@ def plot_surface(kind, x, y, z, coeffs, degree, level, size, out):
 
 def plot_factor(windows, column, label, out, name):
     fig, axes = plt.subplots(1, 2, figsize=(11, 3.8))
-    for ax, kind, track in ((axes[0], "points", "mean_point_track"), (axes[1], "lines", "mean_line_track")):
+    for ax, kind, track in ((axes[0], "points", "mean_point_track"),
+                            (axes[1], "lines", "mean_line_track")):
         x, y = windows[column], windows[track]
         ok = y > 0
         ax.scatter(x[ok], y[ok], s=6, alpha=0.35)
@@ -146,7 +147,8 @@ def plot_factor(windows, column, label, out, name):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap = argparse.ArgumentParser(description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("dirs", nargs="+", help="folders written by alvio run --analysis")
     ap.add_argument("--out", required=True, help="output folder (plots, selection_surfaces.yaml)")
     ap.add_argument("--degree", type=int, default=3, help="polynomial degree of the surfaces")
@@ -174,21 +176,26 @@ def main():
         kept = float(np.mean(pred >= level))
         surfaces[kind] = (coeffs, level)
         png = plot_surface(kind, x, y, z, coeffs, args.degree, level, size, args.out)
-        report.append(f"{kind}: {len(z)} features, mean track {z.mean():.2f} frames, surface R^2 {r2:.3f}, "
+        report.append(f"{kind}: {len(z)} features, mean track {z.mean():.2f} frames, "
+                      f"surface R^2 {r2:.3f}, "
                       f"level {level:.3f} (quantile {quantile}) keeps {100 * kept:.1f} % -> {png}")
 
     windows = load(args.dirs, "windows.csv")
     if windows:
-        report.append("illumination: " + plot_factor(windows, "mean_intensity", "mean intensity of the window",
+        report.append("illumination: " + plot_factor(windows, "mean_intensity",
+                                                     "mean intensity of the window",
                                                      args.out, "track_vs_illumination.png"))
-        report.append("motion: " + plot_factor(windows, "motion_m", "motion |dx|+|dy|+|dz| over the window [m]",
+        report.append("motion: " + plot_factor(windows, "motion_m",
+                                               "motion |dx|+|dy|+|dz| over the window [m]",
                                                args.out, "track_vs_motion.png"))
 
     path = os.path.join(args.out, "selection_surfaces.yaml")
     with open(path, "w") as f:
         f.write("# Written by alvio analyze from: " + ", ".join(args.dirs) + "\n")
-        f.write("# Expected track length over the image, evaluated at (x/width - 0.5, y/height - 0.5) with\n")
-        f.write("# monomials u^i v^j (i + j <= degree) in order of total degree, then increasing j.\n")
+        f.write("# Expected track length over the image, evaluated at "
+                "(x/width - 0.5, y/height - 0.5) with\n")
+        f.write("# monomials u^i v^j (i + j <= degree) in order of total degree, "
+                "then increasing j.\n")
         f.write(f"width: {size[0]}\nheight: {size[1]}\ndegree: {args.degree}\n")
         for kind, (coeffs, level) in surfaces.items():
             f.write(f"{kind}:\n  min_expected_track: {level:.6f}\n")

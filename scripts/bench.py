@@ -58,8 +58,10 @@ VARIANTS = {
     "equal-weights": f"--set {SEL}adaptive_weighting=false",
     "adaptive": f"--set {SEL}adaptive_weighting=true",
     "sel-none": f"--set {SEL}adaptive_weighting=true",
-    "sel-lines": f"--set {SEL}adaptive_weighting=true,{SEL}lines=true,{SEL}surfaces_file={SURFACES}",
-    "sel-points": f"--set {SEL}adaptive_weighting=true,{SEL}points=true,{SEL}surfaces_file={SURFACES}",
+    "sel-lines": f"--set {SEL}adaptive_weighting=true,{SEL}lines=true,"
+    f"{SEL}surfaces_file={SURFACES}",
+    "sel-points": f"--set {SEL}adaptive_weighting=true,{SEL}points=true,"
+    f"{SEL}surfaces_file={SURFACES}",
     "sel-both": f"--set {SEL}adaptive_weighting=true,{SEL}points=true,{SEL}lines=true,"
     f"{SEL}surfaces_file={SURFACES}",
 }
@@ -339,9 +341,11 @@ def bench_table(results):
              "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in results:
         init = r.get("init") or {}
-        pts = f"{fmt(r.get('points_front_end_median'), '.1f')} / {fmt(r.get('points_front_end_mean'), '.1f')}"
+        pts = (f"{fmt(r.get('points_front_end_median'), '.1f')} / "
+               f"{fmt(r.get('points_front_end_mean'), '.1f')}")
         lns = ("–" if r.get("lines_front_end_median") is None else
-               f"{fmt(r['lines_front_end_median'], '.1f')} / {fmt(r['lines_front_end_mean'], '.1f')}")
+               f"{fmt(r['lines_front_end_median'], '.1f')} / "
+               f"{fmt(r['lines_front_end_mean'], '.1f')}")
         rtf = r["duration_s"] / r["wall_s"] if r.get("duration_s") and r.get("wall_s") else None
         lines.append(
             f"| {r['sequence']} | {r['variant']} | {ate_cell(r)} | {fmt(r.get('resets'), 'd')} "
@@ -461,37 +465,50 @@ def ablation_table(results, seq):
         r = by.get(v, {})
         dt = ratio(ref.get("opt_total_median"), r.get("opt_total_median"))
         da = ratio(ref.get("ate"), r.get("ate"))
+        time_vs_ref = ("reference" if v == "sel-none" else
+                       fmt(None if dt is None else 100 * (dt - 1), "+.1f") + " %")
+        ate_vs_ref = ("reference" if v == "sel-none" else
+                      fmt(None if da is None else 100 * (da - 1), "+.1f") + " %")
         lines.append(
             f"| {label} | {fmt(r.get('points_used'), '.1f')} | {fmt(r.get('lines_used'), '.1f')} "
             f"| {fmt(r.get('opt_total_median'), '.2f')} "
-            f"| {'reference' if v == 'sel-none' else fmt(None if dt is None else 100 * (dt - 1), '+.1f') + ' %'} "
+            f"| {time_vs_ref} "
             f"| {ate_cell(r)} "
-            f"| {'reference' if v == 'sel-none' else fmt(None if da is None else 100 * (da - 1), '+.1f') + ' %'} |")
+            f"| {ate_vs_ref} |")
     return "\n".join(lines)
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--data", default=os.environ.get("ALVIO_BENCHMARK_DATA", str(ROOT / "out" / "sim_benchmark")),
+    ap = argparse.ArgumentParser(description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--data", default=os.environ.get("ALVIO_BENCHMARK_DATA",
+                                                     str(ROOT / "out" / "sim_benchmark")),
                     help="benchmark set folder (alvio sim --benchmark DIR) [%(default)s]")
     ap.add_argument("--sequences", "--dataset", default=None,
                     help="comma-separated sequence names or dataset folders")
-    ap.add_argument("--variants", default="points,lines", help="comma-separated variants [%(default)s]")
-    ap.add_argument("--compare", nargs=2, metavar=("A", "B"), help="compare two variants, as ratios B/A")
-    ap.add_argument("--ablation", action="store_true", help="the paper's four selection configurations")
-    ap.add_argument("--out", default=str(ROOT / "out" / "bench"), help="run folders and tables [%(default)s]")
+    ap.add_argument("--variants", default="points,lines",
+                    help="comma-separated variants [%(default)s]")
+    ap.add_argument("--compare", nargs=2, metavar=("A", "B"),
+                    help="compare two variants, as ratios B/A")
+    ap.add_argument("--ablation", action="store_true",
+                    help="the paper's four selection configurations")
+    ap.add_argument("--out", default=str(ROOT / "out" / "bench"),
+                    help="run folders and tables [%(default)s]")
     ap.add_argument("--jobs", type=int, default=1, help="runs at once [%(default)s]")
     ap.add_argument("--side-by-side", action="store_true",
                     help="with --compare: each pair of runs at once, one variant per core "
                     "(swapped from pair to pair), and the pooled ratio of their median frame "
                     "times; needs two cores")
-    ap.add_argument("--max-frames", type=int, default=-1, help="stop each run after this many images")
+    ap.add_argument("--max-frames", type=int, default=-1,
+                    help="stop each run after this many images")
     ap.add_argument("--opencv-threads", type=int, default=1,
                     help="alvio run's --opencv-threads: 1 keeps each run on one core (issue 10's "
                          "single-thread figures; trajectories are the same with more); 0 leaves "
-                         "OpenCV's own default, and is needed for builds before the option [%(default)s]")
+                         "OpenCV's own default, and is needed for builds before the option "
+                         "[%(default)s]")
     ap.add_argument("--repeats", type=int, default=1,
-                    help="runs per sequence and variant, each with --perturb's key nudged [%(default)s]")
+                    help="runs per sequence and variant, each with --perturb's key nudged "
+                    "[%(default)s]")
     ap.add_argument("--perturb", default="estimator.point_sigma_px",
                     help="the configuration key --repeats scales [%(default)s]")
     ap.add_argument("--perturb-step", type=float, default=7e-4,
@@ -499,7 +516,8 @@ def main():
     ap.add_argument("--seeds", default="1",
                     help="comma-separated noise seeds; seed S > 1 runs DATA/seedS's copy of each "
                     "sequence [%(default)s]")
-    ap.add_argument("--bin", default=os.environ.get("ALVIO_RUN", str(ROOT / "build/devel/lib/alvio/alvio_run")))
+    ap.add_argument("--bin", default=os.environ.get("ALVIO_RUN",
+                                                    str(ROOT / "build/devel/lib/alvio/alvio_run")))
     ap.add_argument("--freeze", action="store_true",
                     help="copy the build's programs, libraries and config into OUT/frozen first "
                     "(refused while a build is running), so that a rebuild during the runs or "
@@ -558,7 +576,8 @@ def main():
     # with --render, once the rendering is done.
     if not a.render:
         datasets = sequence_folders()
-    if any(v in ("sel-lines", "sel-points", "sel-both") for v in variants) and not SURFACES.exists():
+    if (any(v in ("sel-lines", "sel-points", "sel-both") for v in variants)
+            and not SURFACES.exists()):
         sys.exit(f"alvio bench: {SURFACES} is missing (make it with ./alvio analyze)")
     out = Path(a.out)
     # Frozen first, so that --render uses the frozen simulator too: a rebuild during a long
@@ -638,7 +657,8 @@ def main():
                  f"{f', {a.repeats} each' if a.repeats > 1 else ''}; ATE is their mean (range), "
                  "times and memory their median.")
     elif a.repeats > 1:
-        text += (f"\n\nEach row: {a.repeats} runs with {a.perturb} scaled by 1, 1 ± {a.perturb_step:g}, "
+        text += (f"\n\nEach row: {a.repeats} runs with {a.perturb} scaled by 1, "
+                 f"1 ± {a.perturb_step:g}, "
                  "...; ATE is their mean (range), times and memory their median.")
     if any(is_real_imu(name) for name, _, _ in datasets):
         text += ("\n\nSequences with the real EuRoC IMU (`*_realimu`) run with "

@@ -15,7 +15,8 @@ FIELDS = ["state", "frames", "dropped_frames", "frontend_ms", "estimator_ms", "l
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap = argparse.ArgumentParser(description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("bag")
     ap.add_argument("--json", help="write the figures to this file")
     args = ap.parse_args()

@@ -66,7 +66,8 @@ def read_scene_edges(sequence):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap = argparse.ArgumentParser(description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("per_line", nargs="+", help="alvio_map_truth --per-line CSV files")
     ap.add_argument("--out", required=True, help="PNG file")
     ap.add_argument("--titles", help="comma-separated panel titles [the file names]")

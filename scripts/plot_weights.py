@@ -21,7 +21,8 @@ COLUMNS = ["t", "w_p", "w_l", "alpha", "points_used", "lines_used"]  # the colum
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap = argparse.ArgumentParser(description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("run", help="an alvio run folder (with frame_stats.csv)")
     ap.add_argument("--out", help="PNG file [RUN/weights.png]")
     a = ap.parse_args()

@@ -8,7 +8,8 @@ scale and gravity error of the initialised window, and the ATE of the segment. A
 OUT/starts.png (ATE and scale error against the start time).
 
   ./alvio starts --dataset out/demo/sim --starts 2:20:1 --out out/starts
-  ./alvio starts --dataset DIR --starts 10,20,30 --frames 400 --set estimator.init_min_parallax_px=60
+  ./alvio starts --dataset DIR --starts 10,20,30 --frames 400 \\
+      --set estimator.init_min_parallax_px=60
 """
 import argparse
 import json
@@ -148,8 +149,9 @@ def main():
     with ThreadPoolExecutor(max_workers=max(1, args.jobs)) as pool:
         for row in pool.map(lambda s: run_one(args, s), starts):
             rows.append(row)
+            scale = None if row.get("scale_error") is None else 100 * row["scale_error"]
             log(f"start {row['start_s']:g} s: ATE {fmt(row.get('ate_m'), '.3f')} m, scale error "
-                f"{fmt(None if row.get('scale_error') is None else 100 * row['scale_error'], '.1f')} %")
+                f"{fmt(scale, '.1f')} %")
     summary = summarize(rows, args.diverged_m)
     text = table(rows, summary, args.diverged_m)
     (Path(args.out) / "starts.md").write_text(text)

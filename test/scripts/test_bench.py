@@ -676,7 +676,8 @@ class MainTest(unittest.TestCase):
 
     def test_missing_sequence_stops_before_freezing(self):
         # A build --freeze could copy: a mistyped name must not leave OUT/frozen behind.
-        p = self.bench("--bin", str(self.fake_build()), "--freeze", "--sequences", "sim_A,sim_nowhere")
+        p = self.bench("--bin", str(self.fake_build()), "--freeze",
+                       "--sequences", "sim_A,sim_nowhere")
         self.assertNotEqual(p.returncode, 0)
         self.assertIn(str(self.data / "sim_nowhere"), p.stderr)
         self.assertFalse((self.dir / "out" / "frozen").exists())

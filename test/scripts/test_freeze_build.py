@@ -79,7 +79,8 @@ class FreezeBuildTest(unittest.TestCase):
         self.assertEqual(self.freeze().returncode, 0)
         build_library(2)
         env = {k: v for k, v in os.environ.items() if k != "LD_LIBRARY_PATH"}
-        live = subprocess.run([str(lib / "alvio/alvio_run")], env=env, capture_output=True, text=True)
+        live = subprocess.run([str(lib / "alvio/alvio_run")], env=env, capture_output=True,
+                              text=True)
         frozen = subprocess.run([str(self.out / "bin/alvio_run")], env=env, capture_output=True,
                                 text=True)
         self.assertEqual(live.stdout, "2")

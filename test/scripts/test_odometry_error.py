@@ -119,7 +119,8 @@ def make_run(folder, seed, outages=()):
                                 quaternion_xyzw(np.einsum("ij,njk->nik", F, R_est))]),
                fmt="%.9f", header="timestamp tx ty tz qx qy qz qw")
     bias = np.tile([0.01, -0.02, 0.005], (len(k), 1))
-    np.savetxt(run / "states.csv", np.column_stack([stamps, v_est @ F.T, np.zeros((len(k), 3)), bias]),
+    np.savetxt(run / "states.csv",
+               np.column_stack([stamps, v_est @ F.T, np.zeros((len(k), 3)), bias]),
                delimiter=",", fmt="%.9f", header="t,vx,vy,vz,bax,bay,baz,bgx,bgy,bgz",
                comments="")
     # As the offline runner logs them: "<t> <kind> <message>".
@@ -229,8 +230,8 @@ class OdometryErrorTest(CleanFailureAssertions, unittest.TestCase):
             before = np.sqrt((POSITION_DRIFT * SPEED * (end - measured - first_pose)) ** 2 +
                              OUTAGE_A ** 2 * s2 + OUTAGE_B ** 2 * s4)
             s2, s4 = s2 + measured ** 2, s4 + measured ** 4
-            after = np.sqrt((POSITION_DRIFT * SPEED * (end - first_pose)) ** 2 + OUTAGE_A ** 2 * s2 +
-                            OUTAGE_B ** 2 * s4)
+            after = np.sqrt((POSITION_DRIFT * SPEED * (end - first_pose)) ** 2 +
+                            OUTAGE_A ** 2 * s2 + OUTAGE_B ** 2 * s4)
             self.assertAlmostEqual(dp, np.sqrt(3) * (after - before), delta=0.002,
                                    msg=f"outage {n}")
             self.assertGreater(dyaw, 0.0, f"outage {n}")
