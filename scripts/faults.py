@@ -11,6 +11,8 @@ it took to track again after the fault ended.
   ./alvio faults [--dataset EUROC_DIR] [--config YAML] [--only a,b]
                  [--modes offline,nodelet] [--rate R] [--out DIR]
 
+--only also takes gaps of any length: image_gap_3s, imu_gap_0.25s.
+
 Default input: the demo sequence (30 s figure eight, rendered when missing). The fast
 rotation is rendered by alvio_sim along the input's ground truth with a 360-degree yaw
 spin inserted. Results: OUT/faults.md and OUT/faults.json; each run's files stay in
@@ -212,6 +214,39 @@ FAULTS = [
     Fault("bad_images", "wrong size, unknown encoding or truncated data in every image for 1 s",
           1.0, bad_images),
 ]
+
+# Gaps of any length, by name (image_gap_3s, imu_gap_0.25s): outages of several lengths are
+# what scripts/odometry_error.py fits the odometry's outage sigmas on.
+GAP_TOPICS = {"image_gap": (IMAGE_TOPIC, "images"), "imu_gap": (IMU_TOPIC, "IMU")}
+MAX_GAP_S = 60.0
+
+
+def fault_named(name):
+    """The fault of this name: one of FAULTS, or a gap of any length; None when unknown."""
+    for f in FAULTS:
+        if f.name == name:
+            return f
+    kind, _, length = name.rpartition("_")
+    if kind not in GAP_TOPICS or not length.endswith("s"):
+        return None
+    try:
+        seconds = float(length[:-1])
+    except ValueError:
+        return None
+    if not 0 < seconds <= MAX_GAP_S:
+        return None
+    topic, what = GAP_TOPICS[kind]
+    return Fault(name, f"no {what} for {seconds:g} s", seconds, drop_topic(topic))
+
+
+def faults_named(names):
+    """The faults of a comma-separated list, in its order; exits naming any unknown one."""
+    found = [(n, fault_named(n)) for n in dict.fromkeys(names.split(","))]  # once each
+    unknown = [n for n, f in found if f is None]
+    if unknown:
+        sys.exit(f"faults: unknown fault(s) {unknown}; known: {[f.name for f in FAULTS]}, and "
+                 f"image_gap_<S>s or imu_gap_<S>s for a gap of S seconds (0 < S <= {MAX_GAP_S:g})")
+    return [f for _, f in found]
 
 
 # --- inputs ------------------------------------------------------------------------------
@@ -463,7 +498,8 @@ def table(results):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
                                  formatter_class=argparse.RawDescriptionHelpFormatter,
-                                 epilog="faults: " + ", ".join(f.name for f in FAULTS))
+                                 epilog="faults: " + ", ".join(f.name for f in FAULTS) +
+                                 "; also image_gap_<S>s and imu_gap_<S>s of any length")
     ap.add_argument("--dataset", help="EuRoC folder with ground truth (default: the demo sequence)")
     # Given to the offline and the nodelet runs alike (ros_demo.sh does not read ALVIO_CONFIG);
     # a real IMU's sequence wants config/euroc_real.yaml.
@@ -471,7 +507,8 @@ def main():
                     default=os.environ.get("ALVIO_CONFIG", str(ROOT / "config/euroc.yaml")),
                     help="alvio configuration of every run (default: $ALVIO_CONFIG, else "
                          "config/euroc.yaml)")
-    ap.add_argument("--only", help="comma-separated fault names")
+    ap.add_argument("--only", help="comma-separated fault names; image_gap_<S>s and "
+                                   "imu_gap_<S>s take any length S in seconds (image_gap_3s)")
     ap.add_argument("--modes", default="offline,nodelet")
     ap.add_argument("--rate", type=float, default=0.5, help="nodelet playback rate")
     ap.add_argument("--fault-at", type=float, default=0.4,
@@ -487,13 +524,7 @@ def main():
     for m in modes:
         if m not in ("offline", "nodelet"):
             sys.exit(f"faults: unknown mode '{m}' (offline, nodelet)")
-    faults = FAULTS
-    if args.only:
-        names = args.only.split(",")
-        unknown = [n for n in names if n not in {f.name for f in FAULTS}]
-        if unknown:
-            sys.exit(f"faults: unknown fault(s) {unknown}; known: {[f.name for f in FAULTS]}")
-        faults = [f for f in FAULTS if f.name in names]
+    faults = faults_named(args.only) if args.only else FAULTS
 
     env = ros_env(args.build)
     sys.path[:0] = [p for p in env.get("PYTHONPATH", "").split(":") if p]
@@ -537,7 +568,8 @@ def main():
                 if res["nan_poses"] or res.get("nan_odometry"):
                     res["completed"] = False
                     res["why"] = (f"{res['nan_poses']} NaN pose(s), "
-                                  f"{res.get('nan_odometry', 0)} odometry message(s) with NaN or Inf")
+                                  f"{res.get('nan_odometry', 0)} odometry message(s) with NaN "
+                                  f"or Inf")
             res.update(fault=fault.name, mode=mode, what=fault.what)
             results.append(res)
             log(f"    {mode}: " + ", ".join(f"{k}={v}" for k, v in res.items()

@@ -16,8 +16,8 @@ def main():
     if len(sys.argv) != 5:
         sys.exit(__doc__)
     clean, name, seconds, out = sys.argv[1], sys.argv[2], float(sys.argv[3]), sys.argv[4]
-    by_name = {f.name: f for f in faults.FAULTS}
-    if name not in by_name or by_name[name].mutate is None:
+    fault = faults.fault_named(name)
+    if fault is None or fault.mutate is None:
         sys.exit(f"make_fault_bag.py: no fault {name!r} that rewrites a bag; known: "
                  f"{[f.name for f in faults.FAULTS if f.mutate is not None]}")
     import rosbag  # from Debian's ROS packages
@@ -25,7 +25,7 @@ def main():
         first = next(bag.read_messages(topics=[faults.IMAGE_TOPIC]), None)
     if first is None:
         sys.exit(f"make_fault_bag.py: {clean} has no {faults.IMAGE_TOPIC}")
-    faults.write_faulted_bag(clean, by_name[name], faults.stamp_s(first.message) + seconds, out)
+    faults.write_faulted_bag(clean, fault, faults.stamp_s(first.message) + seconds, out)
 
 
 if __name__ == "__main__":
