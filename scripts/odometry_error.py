@@ -2,7 +2,7 @@
 """How far alvio's odometry is from the truth, component by component, and the
 `odometry_covariance:` sigmas that describe it.
 
-    scripts/odometry_error.py RUN:DATASET [RUN:DATASET ...] [--config YAML]
+    scripts/odometry_error.py RUN:DATASET [RUN:DATASET ...] [--config YAML [--outages-only]]
 
 RUN is an `alvio run --out` folder (trajectory.tum, states.csv, events.log); DATASET the
 EuRoC/ASL folder it ran on, with mav0/state_groundtruth_estimate0/data.csv (position,
@@ -27,7 +27,9 @@ e^2 = s0^2 + (k d)^2 + sum over the outages before the pose of (a T)^2 + (b T^2)
 d the path and T each outage's length (a, b, c are fitted only when the runs have an outage),
 and per outage the error's jump across it. With
 --config it also prints how often that configuration's model holds each error within 1 and 2
-sigma (a Gaussian: 68 % and 95 %), to check sigmas on runs that did not set them.
+sigma (a Gaussian: 68 % and 95 %), to check sigmas on runs that did not set them. With
+--outages-only it fits a, b and c alone, the configuration's s0, k and yaw terms held: fit
+those on runs without faults first, then the outages on runs with them (./alvio faults).
 """
 import argparse
 import sys
@@ -169,7 +171,7 @@ def fit_growth(errors_sq, *columns):
     subsets of the terms, whose coefficients are all >= 0."""
     A = np.stack(columns, 1)
     m = A.shape[1]
-    best = None
+    best = (np.sum(np.square(errors_sq)), np.zeros(m))  # no term at all
     for subset in range(1, 2 ** m):
         cols = [j for j in range(m) if subset >> j & 1]
         coef, *_ = np.linalg.lstsq(A[:, cols], errors_sq, rcond=None)
@@ -200,6 +202,22 @@ def fit(all_errors):
         "velocity_sigma_mps": float(np.max(rms(e["velocity"]))),
         "angular_rate_sigma_rps": [float(x) for x in rms(e["rate"])],
     }, n
+
+
+def fit_outages(all_errors, model):
+    """The outage sigmas alone, the model's path terms held: for runs with faults, once the
+    path terms were fitted on runs without."""
+    e = {k: np.concatenate([r[k] for r in all_errors]) for k in all_errors[0]}
+    d = e["path"]
+    position_sq = (np.square(e["position"]) -
+                   (model["position_sigma_m"] ** 2 + (model["position_drift"] * d) ** 2)[:, None])
+    yaw_sq = np.square(e["yaw"]) - model["yaw_sigma_deg"] ** 2 - \
+        (model["yaw_drift_deg_per_m"] * d) ** 2
+    a, b = fit_growth(position_sq.reshape(-1), np.repeat(e["outage_s2"], 3),
+                      np.repeat(e["outage_s4"], 3))
+    c, = fit_growth(yaw_sq, e["outage_s2"])
+    return {"outage_position_sigma_mps": a, "outage_position_sigma_mps2": b,
+            "outage_yaw_sigma_deg_per_s": c}
 
 
 def load_model(path):
@@ -280,7 +298,12 @@ def main():
     ap.add_argument("runs", nargs="+", metavar="RUN:DATASET")
     ap.add_argument("--config", help="check this configuration's odometry_covariance sigmas "
                     "(its outage_min_s also says what an outage is)")
+    ap.add_argument("--outages-only", action="store_true",
+                    help="fit only the outage sigmas, holding --config's position and yaw "
+                    "terms (fitted before on runs without outages)")
     args = ap.parse_args()
+    if args.outages_only and not args.config:
+        fail("--outages-only holds the path terms of a configuration: give it with --config")
     model = load_model(args.config) if args.config else None
     outage_min_s = model["outage_min_s"] if model else OUTAGE_MIN_S
     all_errors = []
@@ -300,11 +323,20 @@ def main():
               f"{e['resets'][-1]} | {np.linalg.norm(e['position'][-1]):.3f} | "
               f"{rms(e['yaw']):.3f} | {np.max(rms(e['tilt'])):.3f} | {velocity} | {rate} |")
     fitted, n = fit(all_errors)
-    print(f"\nFitted over {len(all_errors)} run(s), {n} poses:\n\nodometry_covariance:")
     any_outage = any(e["outages"][-1] > 0 for e in all_errors)
+    held = ""
+    if args.outages_only:
+        if not any_outage:
+            fail("--outages-only: no run has an outage (a pause in the output over "
+                 f"{outage_min_s:g} s) to fit them on")
+        fitted = fit_outages(all_errors, model)
+        held = f", {args.config}'s position and yaw terms held"
+    print(f"\nFitted over {len(all_errors)} run(s), {n} poses{held}:\n\nodometry_covariance:")
     for k in KEYS:
         if k == "outage_min_s" or (k in OUTAGE_KEYS and not any_outage):
             continue  # a setting, not fitted; nothing to fit them on: noted below
+        if k not in fitted:
+            continue  # held
         v = fitted[k]
         print(f"  {k}: " + (f"[{', '.join(f'{x:.4g}' for x in v)}]" if isinstance(v, list)
                             else f"{v:.4g}"))

@@ -253,6 +253,39 @@ class OdometryErrorTest(CleanFailureAssertions, unittest.TestCase):
             # path's alone.
             self.assertLess(rows["without"][part][0], 2.0, part)
 
+    def test_outages_only_fits_them_with_the_configurations_path_terms_held(self):
+        config = self.true_model("held.yaml", outage_scale=None)
+        p = run_script(f"{self.reset_run}:{self.reset_data}", "--config", config,
+                       "--outages-only")
+        self.assertEqual(p.returncode, 0, p.stderr)
+        self.assertIn("position and yaw terms held", p.stdout)
+        got = fitted(p.stdout.split("'s sigmas: share of errors")[0])
+        self.assertEqual(set(got), {"outage_position_sigma_mps", "outage_position_sigma_mps2",
+                                    "outage_yaw_sigma_deg_per_s"})
+        for key, want in (("outage_position_sigma_mps", OUTAGE_A),
+                          ("outage_position_sigma_mps2", OUTAGE_B),
+                          ("outage_yaw_sigma_deg_per_s", OUTAGE_C)):
+            self.assertAlmostEqual(got[key], want, delta=0.05 * want, msg=key)
+        # Held, not fitted: a configuration whose drift takes 3x the path's variance leaves
+        # less to the outages.
+        wide = Path(self.tmp.name) / "held_wide.yaml"
+        wide.write_text(config.read_text().replace(
+            f"position_drift: {POSITION_DRIFT * 1.0001}", f"position_drift: {POSITION_DRIFT * 3}"))
+        p = run_script(f"{self.reset_run}:{self.reset_data}", "--config", wide, "--outages-only")
+        self.assertEqual(p.returncode, 0, p.stderr)
+        less = fitted(p.stdout.split("'s sigmas: share of errors")[0])
+        self.assertLess(less["outage_position_sigma_mps"] ** 2 * 36 +
+                        less["outage_position_sigma_mps2"] ** 2 * 36 ** 2,
+                        0.9 * (OUTAGE_A ** 2 * 36 + OUTAGE_B ** 2 * 36 ** 2))
+
+    def test_outages_only_needs_a_configuration_and_an_outage(self):
+        self.assertFailsCleanly(run_script(f"{self.reset_run}:{self.reset_data}",
+                                           "--outages-only"),
+                                "--outages-only holds the path terms of a configuration")
+        self.assertFailsCleanly(run_script(f"{self.run_dir}:{self.data}", "--config",
+                                           self.true_model("held2.yaml"), "--outages-only"),
+                                "--outages-only: no run has an outage")
+
     def test_the_replaced_reset_keys_are_named(self):
         config = Path(self.tmp.name) / "old_reset_keys.yaml"
         config.write_text(self.true_model("base.yaml").read_text() +
