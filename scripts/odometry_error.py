@@ -22,7 +22,7 @@ the estimator nodelet's odometry message:
 
 It prints each run's errors, then the sigmas fitted over all runs: the angular rate's RMS per
 axis (a gyroscope on a vibrating body is noisier on some axes), velocity and tilt the largest
-per-axis RMS, position and yaw the least-squares fits, all terms >= 0, of
+per-axis RMS, position and yaw the Gaussian maximum-likelihood fits, all terms >= 0, of
 e^2 = s0^2 + (k d)^2 + sum over the outages before the pose of (a T)^2 + (b T^2)^2 (yaw: (c T)^2),
 d the path and T each outage's length (a, b, c are fitted only when the runs have an outage),
 and per outage the error's jump across it. With
@@ -163,26 +163,44 @@ def rms(x, axis=0):
     return np.sqrt(np.mean(np.square(x), axis=axis))
 
 
-def fit_growth(errors_sq, *columns):
-    """The sigmas s of e^2 = sum s_j^2 x_j (x_j the columns) by least squares on the squares,
-    all >= 0.
-
-    With a few unknowns the constrained optimum is the best unconstrained fit, over the
-    subsets of the terms, whose coefficients are all >= 0."""
-    A = np.stack(columns, 1)
+def nonnegative_lstsq(A, b):
+    """min |A x - b| with x >= 0. With a few unknowns the constrained optimum is the best
+    unconstrained fit, over the subsets of the terms, whose coefficients are all >= 0."""
     m = A.shape[1]
-    best = (np.sum(np.square(errors_sq)), np.zeros(m))  # no term at all
+    best = (np.sum(np.square(b)), np.zeros(m))  # no term at all
     for subset in range(1, 2 ** m):
         cols = [j for j in range(m) if subset >> j & 1]
-        coef, *_ = np.linalg.lstsq(A[:, cols], errors_sq, rcond=None)
+        coef, *_ = np.linalg.lstsq(A[:, cols], b, rcond=None)
         if np.any(coef < 0):
             continue
         full = np.zeros(m)
         full[cols] = coef
-        residual = np.sum(np.square(A @ full - errors_sq))
-        if best is None or residual < best[0]:
+        residual = np.sum(np.square(A @ full - b))
+        if residual < best[0]:
             best = (residual, full)
-    return tuple(float(np.sqrt(c)) for c in best[1])
+    return best[1]
+
+
+def fit_growth(errors_sq, *columns, offset=None, iterations=50):
+    """The sigmas s of e^2 = offset + sum s_j^2 x_j (x_j the columns), all >= 0, by Gaussian
+    maximum likelihood: least squares on the squares, each weighted by 1 / variance^2 (the
+    spread of e^2 grows with its variance), iterated from the unweighted fit.
+
+    Unweighted, the few largest errors (a long outage) would set the sigmas, too narrow for
+    the many smaller ones (sixty-eighth session)."""
+    A = np.stack(columns, 1)
+    offset = np.zeros_like(errors_sq) if offset is None else offset
+    b = errors_sq - offset
+    coef = nonnegative_lstsq(A, b)
+    floor = 1e-12 + 1e-9 * np.mean(errors_sq)  # no infinite weight where the model says 0
+    for _ in range(iterations):
+        w = 1.0 / np.maximum(offset + A @ coef, floor)
+        new = nonnegative_lstsq(A * w[:, None], b * w)
+        done = np.allclose(new, coef, rtol=1e-7, atol=1e-15)
+        coef = new
+        if done:
+            break
+    return tuple(float(np.sqrt(c)) for c in coef)
 
 
 def fit(all_errors):
@@ -209,13 +227,11 @@ def fit_outages(all_errors, model):
     path terms were fitted on runs without."""
     e = {k: np.concatenate([r[k] for r in all_errors]) for k in all_errors[0]}
     d = e["path"]
-    position_sq = (np.square(e["position"]) -
-                   (model["position_sigma_m"] ** 2 + (model["position_drift"] * d) ** 2)[:, None])
-    yaw_sq = np.square(e["yaw"]) - model["yaw_sigma_deg"] ** 2 - \
-        (model["yaw_drift_deg_per_m"] * d) ** 2
-    a, b = fit_growth(position_sq.reshape(-1), np.repeat(e["outage_s2"], 3),
-                      np.repeat(e["outage_s4"], 3))
-    c, = fit_growth(yaw_sq, e["outage_s2"])
+    position_held = model["position_sigma_m"] ** 2 + (model["position_drift"] * d) ** 2
+    yaw_held = model["yaw_sigma_deg"] ** 2 + (model["yaw_drift_deg_per_m"] * d) ** 2
+    a, b = fit_growth(np.square(e["position"]).reshape(-1), np.repeat(e["outage_s2"], 3),
+                      np.repeat(e["outage_s4"], 3), offset=np.repeat(position_held, 3))
+    c, = fit_growth(np.square(e["yaw"]), e["outage_s2"], offset=yaw_held)
     return {"outage_position_sigma_mps": a, "outage_position_sigma_mps2": b,
             "outage_yaw_sigma_deg_per_s": c}
 

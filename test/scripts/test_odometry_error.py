@@ -20,7 +20,7 @@ from script_failures import CleanFailureAssertions
 
 SCRIPT = Path(__file__).resolve().parents[2] / "scripts" / "odometry_error.py"
 sys.path.insert(0, str(SCRIPT.parent))
-from odometry_error import KEYS  # noqa: E402  (the section's keys, as the script reads them)
+from odometry_error import KEYS, fit_growth  # noqa: E402  (the keys, as the script reads them)
 RATE_HZ, CAMERA_EVERY = 200, 10
 DURATION_S = 200.0
 SPEED, RADIUS = 1.0, 5.0              # m/s, m: a 200 m path
@@ -157,6 +157,42 @@ def coverage(stdout):
         if len(cells) == 3 and cells[1].endswith("%"):
             rows[cells[0]] = (float(cells[1][:-1]), float(cells[2][:-1]))
     return rows
+
+
+class FitGrowth(unittest.TestCase):
+    """Independent Gaussian errors whose variance is s0^2 + (a T)^2 + (b T^2)^2: 1800 after
+    short outages (1-1.5 s), 200 after long ones (12-12.5 s), as a run whose few poses after a
+    long outage have errors 10x the others'."""
+    S0, A, B = 0.01, 0.05, 0.004
+
+    def fits(self, iterations):
+        out = []
+        for seed in range(20):
+            rng = np.random.default_rng(seed)
+            t = np.where(np.arange(2000) < 1800, 1.0, 12.0) + rng.uniform(0, 0.5, 2000)
+            var = self.S0 ** 2 + (self.A * t) ** 2 + (self.B * t ** 2) ** 2
+            e = rng.normal(0.0, np.sqrt(var))
+            out.append(fit_growth(e ** 2, np.ones_like(t), t ** 2, t ** 4,
+                                  iterations=iterations))
+        return np.array(out)
+
+    def test_maximum_likelihood_gives_the_sigmas_back_where_least_squares_scatters(self):
+        ml, ls = self.fits(50), self.fits(0)
+        truth = np.array([self.S0, self.A, self.B])
+        ml_error, ls_error = (np.sqrt(np.mean(np.square(f - truth), 0)) for f in (ml, ls))
+        # a and b, which the outages set: within 15 % (RMS over the seeds), and at least 3x
+        # closer than the unweighted fit, which the long outages' few errors set.
+        for j, name in ((1, "a"), (2, "b")):
+            self.assertLess(ml_error[j], 0.15 * truth[j], name)
+            self.assertLess(ml_error[j], ls_error[j] / 3, name)
+
+    def test_a_held_offset_is_not_fitted(self):
+        t = np.linspace(1, 10, 500)
+        e_sq = 0.02 ** 2 + (0.03 * t) ** 2
+        a, = fit_growth(e_sq, t ** 2, offset=np.full_like(t, 0.02 ** 2))
+        self.assertAlmostEqual(a, 0.03, places=6)
+        none, = fit_growth(e_sq, t ** 2, offset=e_sq * 2)  # the offset says more than all
+        self.assertEqual(none, 0.0)
 
 
 class OdometryErrorTest(CleanFailureAssertions, unittest.TestCase):
