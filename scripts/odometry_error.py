@@ -22,14 +22,15 @@ the estimator nodelet's odometry message:
 
 It prints each run's errors, then the sigmas fitted over all runs: the angular rate's RMS per
 axis (a gyroscope on a vibrating body is noisier on some axes), velocity and tilt the largest
-per-axis RMS, position and yaw the Gaussian maximum-likelihood fits, all terms >= 0, of
+per-axis RMS, position and yaw the least-squares fits, all terms >= 0, of
 e^2 = s0^2 + (k d)^2 + sum over the outages before the pose of (a T)^2 + (b T^2)^2 (yaw: (c T)^2),
 d the path and T each outage's length (a, b, c are fitted only when the runs have an outage),
 and per outage the error's jump across it. With
 --config it also prints how often that configuration's model holds each error within 1 and 2
 sigma (a Gaussian: 68 % and 95 %), to check sigmas on runs that did not set them. With
---outages-only it fits a, b and c alone, the configuration's s0, k and yaw terms held: fit
-those on runs without faults first, then the outages on runs with them (./alvio faults).
+--outages-only it fits a, b and c alone, by Gaussian maximum likelihood, the configuration's
+s0, k and yaw terms held: fit those on runs without faults first, then the outages on runs
+with them (./alvio faults).
 """
 import argparse
 import sys
@@ -181,19 +182,22 @@ def nonnegative_lstsq(A, b):
     return best[1]
 
 
-def fit_growth(errors_sq, *columns, offset=None, iterations=50):
-    """The sigmas s of e^2 = offset + sum s_j^2 x_j (x_j the columns), all >= 0, by Gaussian
-    maximum likelihood: least squares on the squares, each weighted by 1 / variance^2 (the
-    spread of e^2 grows with its variance), iterated from the unweighted fit.
+def fit_growth(errors_sq, *columns, offset=None, weighted=False, iterations=50):
+    """The sigmas s of e^2 = offset + sum s_j^2 x_j (x_j the columns), all >= 0, by least
+    squares on the squares; weighted, by Gaussian maximum likelihood: each square weighted by
+    1 / variance^2 (the spread of e^2 grows with its variance), iterated from the unweighted
+    fit.
 
-    Unweighted, the few largest errors (a long outage) would set the sigmas, too narrow for
-    the many smaller ones (sixty-eighth session)."""
+    The outages' terms are fitted weighted: unweighted, the few largest errors (after the
+    longest outages) set them, too narrow for the many smaller ones. The path's terms are not:
+    the output is anchored at its first pose, so the errors near it are about 0 by
+    construction, and weighted they pull the floor (s0) to 0 (sixty-eighth session)."""
     A = np.stack(columns, 1)
     offset = np.zeros_like(errors_sq) if offset is None else offset
     b = errors_sq - offset
     coef = nonnegative_lstsq(A, b)
     floor = 1e-12 + 1e-9 * np.mean(errors_sq)  # no infinite weight where the model says 0
-    for _ in range(iterations):
+    for _ in range(iterations if weighted else 0):
         w = 1.0 / np.maximum(offset + A @ coef, floor)
         new = nonnegative_lstsq(A * w[:, None], b * w)
         done = np.allclose(new, coef, rtol=1e-7, atol=1e-15)
@@ -230,8 +234,9 @@ def fit_outages(all_errors, model):
     position_held = model["position_sigma_m"] ** 2 + (model["position_drift"] * d) ** 2
     yaw_held = model["yaw_sigma_deg"] ** 2 + (model["yaw_drift_deg_per_m"] * d) ** 2
     a, b = fit_growth(np.square(e["position"]).reshape(-1), np.repeat(e["outage_s2"], 3),
-                      np.repeat(e["outage_s4"], 3), offset=np.repeat(position_held, 3))
-    c, = fit_growth(np.square(e["yaw"]), e["outage_s2"], offset=yaw_held)
+                      np.repeat(e["outage_s4"], 3), offset=np.repeat(position_held, 3),
+                      weighted=True)
+    c, = fit_growth(np.square(e["yaw"]), e["outage_s2"], offset=yaw_held, weighted=True)
     return {"outage_position_sigma_mps": a, "outage_position_sigma_mps2": b,
             "outage_yaw_sigma_deg_per_s": c}
 
@@ -281,6 +286,13 @@ def model_value(path, key, value):
         fail(f"{path}: odometry_covariance.{key} must be {wanted}, got {value!r}")
 
 
+def normalised(e, sigma):
+    """|e| / sigma; where sigma is 0 (a model without a floor, at the first pose), 0 for no
+    error and infinity for any."""
+    e, sigma = np.broadcast_arrays(np.abs(e), sigma)
+    return np.divide(e, sigma, out=np.where(e > 0, np.inf, 0.0), where=sigma > 0)
+
+
 def coverage(model, errors):
     """Fraction of each component's errors within 1 and 2 of the model's sigmas."""
     d, n = errors["path"], errors["outages"]
@@ -292,11 +304,11 @@ def coverage(model, errors):
                  model["outage_yaw_sigma_deg_per_s"] ** 2 * s2)
     # Normalised errors, one per axis and pose.
     parts = {
-        "position": np.abs(errors["position"]) / sp[:, None],
-        "yaw": np.abs(errors["yaw"]) / sy,
-        "tilt": np.abs(errors["tilt"]) / model["tilt_sigma_deg"],
-        "velocity": np.abs(errors["velocity"]) / model["velocity_sigma_mps"],
-        "angular rate": np.abs(errors["rate"]) / model["angular_rate_sigma_rps"],
+        "position": normalised(errors["position"], sp[:, None]),
+        "yaw": normalised(errors["yaw"], sy),
+        "tilt": normalised(errors["tilt"], model["tilt_sigma_deg"]),
+        "velocity": normalised(errors["velocity"], model["velocity_sigma_mps"]),
+        "angular rate": normalised(errors["rate"], model["angular_rate_sigma_rps"]),
     }
     # The poses after an outage on their own: the few that the outage sigmas are for.
     if np.any(n > 0):

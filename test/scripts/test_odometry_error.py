@@ -20,7 +20,7 @@ from script_failures import CleanFailureAssertions
 
 SCRIPT = Path(__file__).resolve().parents[2] / "scripts" / "odometry_error.py"
 sys.path.insert(0, str(SCRIPT.parent))
-from odometry_error import KEYS, fit_growth  # noqa: E402  (the keys, as the script reads them)
+from odometry_error import KEYS, fit_growth, fit_outages, normalised  # noqa: E402
 RATE_HZ, CAMERA_EVERY = 200, 10
 DURATION_S = 200.0
 SPEED, RADIUS = 1.0, 5.0              # m/s, m: a 200 m path
@@ -165,19 +165,18 @@ class FitGrowth(unittest.TestCase):
     long outage have errors 10x the others'."""
     S0, A, B = 0.01, 0.05, 0.004
 
-    def fits(self, iterations):
+    def fits(self, weighted):
         out = []
         for seed in range(20):
             rng = np.random.default_rng(seed)
             t = np.where(np.arange(2000) < 1800, 1.0, 12.0) + rng.uniform(0, 0.5, 2000)
             var = self.S0 ** 2 + (self.A * t) ** 2 + (self.B * t ** 2) ** 2
             e = rng.normal(0.0, np.sqrt(var))
-            out.append(fit_growth(e ** 2, np.ones_like(t), t ** 2, t ** 4,
-                                  iterations=iterations))
+            out.append(fit_growth(e ** 2, np.ones_like(t), t ** 2, t ** 4, weighted=weighted))
         return np.array(out)
 
     def test_maximum_likelihood_gives_the_sigmas_back_where_least_squares_scatters(self):
-        ml, ls = self.fits(50), self.fits(0)
+        ml, ls = self.fits(True), self.fits(False)
         truth = np.array([self.S0, self.A, self.B])
         ml_error, ls_error = (np.sqrt(np.mean(np.square(f - truth), 0)) for f in (ml, ls))
         # a and b, which the outages set: within 15 % (RMS over the seeds), and at least 3x
@@ -186,13 +185,45 @@ class FitGrowth(unittest.TestCase):
             self.assertLess(ml_error[j], 0.15 * truth[j], name)
             self.assertLess(ml_error[j], ls_error[j] / 3, name)
 
+    def test_the_outages_are_fitted_weighted_around_the_held_path_terms(self):
+        model = {"position_sigma_m": self.S0, "position_drift": 0.002, "yaw_sigma_deg": 0.05,
+                 "yaw_drift_deg_per_m": 0.003}
+        c = 0.02  # deg/s
+        errors = []
+        for seed in range(20):
+            rng = np.random.default_rng(100 + seed)
+            t = np.where(np.arange(2000) < 1800, 1.0, 12.0) + rng.uniform(0, 0.5, 2000)
+            d = rng.uniform(0, 50, 2000)
+            var = (self.S0 ** 2 + (0.002 * d) ** 2 + (self.A * t) ** 2 +
+                   (self.B * t ** 2) ** 2)
+            yaw_var = 0.05 ** 2 + (0.003 * d) ** 2 + (c * t) ** 2
+            errors.append({"path": d, "position": rng.normal(0.0, np.sqrt(var)[:, None],
+                                                             (2000, 3)),
+                           "yaw": rng.normal(0.0, np.sqrt(yaw_var)), "outage_s2": t ** 2,
+                           "outage_s4": t ** 4})
+        got = fit_outages(errors, model)
+        for key, want in (("outage_position_sigma_mps", self.A),
+                          ("outage_position_sigma_mps2", self.B),
+                          ("outage_yaw_sigma_deg_per_s", c)):
+            self.assertAlmostEqual(got[key], want, delta=0.05 * want, msg=key)
+
     def test_a_held_offset_is_not_fitted(self):
         t = np.linspace(1, 10, 500)
         e_sq = 0.02 ** 2 + (0.03 * t) ** 2
-        a, = fit_growth(e_sq, t ** 2, offset=np.full_like(t, 0.02 ** 2))
-        self.assertAlmostEqual(a, 0.03, places=6)
-        none, = fit_growth(e_sq, t ** 2, offset=e_sq * 2)  # the offset says more than all
-        self.assertEqual(none, 0.0)
+        for weighted in (False, True):
+            a, = fit_growth(e_sq, t ** 2, offset=np.full_like(t, 0.02 ** 2), weighted=weighted)
+            self.assertAlmostEqual(a, 0.03, places=6)
+            # The offset says more than all the errors: nothing is left to the term.
+            none, = fit_growth(e_sq, t ** 2, offset=e_sq * 2, weighted=weighted)
+            self.assertEqual(none, 0.0)
+
+
+class Normalised(unittest.TestCase):
+    def test_a_zero_sigma_holds_only_a_zero_error_and_warns_of_nothing(self):
+        with np.errstate(all="raise"):  # a division by 0 would raise here
+            z = normalised(np.array([[0.0, -1.0, 2.0], [0.5, 0.0, -0.3]]),
+                           np.array([0.0, 0.0, 2.0]))
+        np.testing.assert_array_equal(z, [[0.0, np.inf, 1.0], [np.inf, 0.0, 0.15]])
 
 
 class OdometryErrorTest(CleanFailureAssertions, unittest.TestCase):
