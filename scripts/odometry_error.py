@@ -2,7 +2,8 @@
 """How far alvio's odometry is from the truth, component by component, and the
 `odometry_covariance:` sigmas that describe it.
 
-    scripts/odometry_error.py RUN:DATASET [RUN:DATASET ...] [--config YAML [--outages-only]]
+    scripts/odometry_error.py RUN:DATASET [RUN:DATASET ...]
+                              [--config YAML [--outages-only] [--plot DIR]]
 
 RUN is an `alvio run --out` folder (trajectory.tum, states.csv, events.log); DATASET the
 EuRoC/ASL folder it ran on, with mav0/state_groundtruth_estimate0/data.csv (position,
@@ -293,15 +294,21 @@ def normalised(e, sigma):
     return np.divide(e, sigma, out=np.where(e > 0, np.inf, 0.0), where=sigma > 0)
 
 
-def coverage(model, errors):
-    """Fraction of each component's errors within 1 and 2 of the model's sigmas."""
-    d, n = errors["path"], errors["outages"]
-    s2, s4 = errors["outage_s2"], errors["outage_s4"]
+def position_yaw_sigmas(model, errors):
+    """The model's sigma at each pose: position (per axis, m) and yaw (deg)."""
+    d, s2, s4 = errors["path"], errors["outage_s2"], errors["outage_s4"]
     sp = np.sqrt(model["position_sigma_m"] ** 2 + (model["position_drift"] * d) ** 2 +
                  model["outage_position_sigma_mps"] ** 2 * s2 +
                  model["outage_position_sigma_mps2"] ** 2 * s4)
     sy = np.sqrt(model["yaw_sigma_deg"] ** 2 + (model["yaw_drift_deg_per_m"] * d) ** 2 +
                  model["outage_yaw_sigma_deg_per_s"] ** 2 * s2)
+    return sp, sy
+
+
+def coverage(model, errors):
+    """Fraction of each component's errors within 1 and 2 of the model's sigmas."""
+    n = errors["outages"]
+    sp, sy = position_yaw_sigmas(model, errors)
     # Normalised errors, one per axis and pose.
     parts = {
         "position": normalised(errors["position"], sp[:, None]),
@@ -321,6 +328,39 @@ def coverage(model, errors):
     return {name: (float(np.mean(z <= 1)), float(np.mean(z <= 2))) for name, z in parts.items()}
 
 
+def plot_run(model, errors, title):
+    """A figure of the run's position (per axis) and yaw errors over time inside the model's
+    1 and 2 sigma bands, its outages shaded: where and after what the sigmas fall short."""
+    import matplotlib
+    matplotlib.use("Agg")  # no display needed
+    import matplotlib.figure
+    t = errors["t"] - errors["t"][0]
+    sp, sy = position_yaw_sigmas(model, errors)
+    fig = matplotlib.figure.Figure(figsize=(10, 8), dpi=100)
+    axes = fig.subplots(4, 1, sharex=True)
+    rows = [(f"position {axis} (m)", errors["position"][:, k], sp)
+            for k, axis in enumerate("xyz")] + [("yaw (deg)", errors["yaw"], sy)]
+    after = np.flatnonzero(np.diff(errors["outages"]) > 0) + 1
+    for ax, (label, e, sigma) in zip(axes, rows):
+        # Stepped: the sigma widens with the first pose after an outage, as it is published.
+        ax.fill_between(t, -2 * sigma, 2 * sigma, step="post", color="tab:blue", alpha=0.12,
+                        lw=0, label="2 sigma")
+        ax.fill_between(t, -sigma, sigma, step="post", color="tab:blue", alpha=0.25, lw=0,
+                        label="1 sigma")
+        ax.plot(t, e, color="black", lw=0.8, label="error")
+        for i in after:
+            ax.axvspan(t[i - 1], t[i], color="tab:red", alpha=0.3, lw=0)
+        within = 100 * np.mean(normalised(e, sigma) <= 1)
+        ax.set_ylabel(label)
+        ax.set_title(f"{within:.0f} % within 1 sigma", fontsize=8, loc="right")
+        ax.grid(alpha=0.3)
+    axes[0].legend(loc="upper left", fontsize=8)
+    axes[-1].set_xlabel("s since the first output pose (red: an outage)")
+    fig.suptitle(title)
+    fig.tight_layout()
+    return fig
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("runs", nargs="+", metavar="RUN:DATASET")
@@ -329,9 +369,14 @@ def main():
     ap.add_argument("--outages-only", action="store_true",
                     help="fit only the outage sigmas, holding --config's position and yaw "
                     "terms (fitted before on runs without outages)")
+    ap.add_argument("--plot", metavar="DIR",
+                    help="write DIR/<n>_<run>.png per run: its position and yaw errors over "
+                    "time in --config's 1 and 2 sigma bands, its outages shaded")
     args = ap.parse_args()
     if args.outages_only and not args.config:
         fail("--outages-only holds the path terms of a configuration: give it with --config")
+    if args.plot and not args.config:
+        fail("--plot draws a configuration's sigma bands: give it with --config")
     model = load_model(args.config) if args.config else None
     outage_min_s = model["outage_min_s"] if model else OUTAGE_MIN_S
     all_errors = []
@@ -386,6 +431,15 @@ def main():
         print("| component | within 1 sigma | within 2 sigma |\n|---|---|---|")
         for name, (one, two) in coverage(model, pooled).items():
             print(f"| {name} | {100 * one:.1f} % | {100 * two:.1f} % |")
+    if args.plot:
+        out = Path(args.plot)
+        out.mkdir(parents=True, exist_ok=True)
+        for number, (spec, e) in enumerate(zip(args.runs, all_errors), 1):
+            run = spec.split(":", 1)[0]
+            name = "_".join(part for part in Path(run).parts if part not in ("/", ".", ".."))
+            png = out / f"{number}_{name}.png"
+            plot_run(model, e, f"{run} against {Path(args.config).name}").savefig(png)
+            print(f"plot: {png}")
 
 
 if __name__ == "__main__":

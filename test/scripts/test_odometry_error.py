@@ -20,7 +20,8 @@ from script_failures import CleanFailureAssertions
 
 SCRIPT = Path(__file__).resolve().parents[2] / "scripts" / "odometry_error.py"
 sys.path.insert(0, str(SCRIPT.parent))
-from odometry_error import KEYS, fit_growth, fit_outages, normalised  # noqa: E402
+from odometry_error import (KEYS, coverage as model_coverage, fit_growth, fit_outages,  # noqa: E402
+                            normalised, plot_run, run_errors)
 RATE_HZ, CAMERA_EVERY = 200, 10
 DURATION_S = 200.0
 SPEED, RADIUS = 1.0, 5.0              # m/s, m: a 200 m path
@@ -352,6 +353,59 @@ class OdometryErrorTest(CleanFailureAssertions, unittest.TestCase):
         self.assertFailsCleanly(run_script(f"{self.run_dir}:{self.data}", "--config",
                                            self.true_model("held2.yaml"), "--outages-only"),
                                 "--outages-only: no run has an outage")
+
+    def test_the_plot_draws_each_error_in_its_bands_and_shades_each_outage(self):
+        # Outage sigmas at half the truth: the errors after an outage lie between 1 and 2 sigma.
+        config = self.true_model("plotted.yaml", outage_scale=0.5)
+        out = Path(self.tmp.name) / "plots"
+        p = run_script(f"{self.reset_run}:{self.reset_data}", f"{self.run_dir}:{self.data}",
+                       "--config", config, "--plot", out)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        pngs = sorted(out.glob("*.png"))
+        self.assertEqual([png.name[:2] for png in pngs], ["1_", "2_"])
+        for png in pngs:
+            self.assertEqual(png.read_bytes()[:8], b"\x89PNG\r\n\x1a\n")
+            self.assertGreater(png.stat().st_size, 30_000)
+        # The figure itself: the errors drawn, the outages shaded, the share within 1 sigma.
+        import odometry_error
+        model = odometry_error.load_model(config)
+        errors = run_errors(self.reset_run, self.reset_data)
+        fig = plot_run(model, errors, "run")
+        axes = fig.axes
+        self.assertEqual(len(axes), 4)
+        t = errors["t"] - errors["t"][0]
+        shares = model_coverage(model, errors)
+        self.assertLess(shares["position"][0], 0.9)  # the share within 1 sigma is not all
+        sp, sy = odometry_error.position_yaw_sigmas(model, errors)
+        for k, ax in enumerate(axes):
+            drawn = ax.lines[0].get_ydata()
+            want = errors["position"][:, k] if k < 3 else errors["yaw"]
+            np.testing.assert_allclose(drawn, want)
+            # The bands: 2 sigma, then 1 sigma, each reaching the model's largest sigma.
+            sigma = sp if k < 3 else sy
+            for band, scale in zip(ax.collections, (2, 1)):
+                top = max(np.max(path.vertices[:, 1]) for path in band.get_paths())
+                self.assertAlmostEqual(top, scale * np.max(sigma), places=9)
+            # The axvspans, one per outage: from the last pose before it to the first after.
+            spans = [(np.min(patch.get_xy()[:, 0]), np.max(patch.get_xy()[:, 0]))
+                     for patch in ax.patches]
+            self.assertEqual(len(spans), len(OUTAGES))
+            first_pose = CAMERA_EVERY / RATE_HZ - 0.001  # after the start
+            frame = 1.01 * CAMERA_EVERY / RATE_HZ
+            for (x0, x1), (end, length, _) in zip(spans, OUTAGES):
+                self.assertAlmostEqual(x1, end - first_pose, delta=frame)
+                self.assertAlmostEqual(x1 - x0, length, delta=frame)
+            self.assertLess(spans[-1][1], t[-1])
+        # The position's axes together hold the check's share within 1 sigma.
+        titles = [float(ax.get_title(loc="right").split(" %")[0]) for ax in axes[:3]]
+        self.assertAlmostEqual(np.mean(titles), 100 * shares["position"][0], delta=1.0)
+        self.assertAlmostEqual(float(axes[3].get_title(loc="right").split(" %")[0]),
+                               100 * shares["yaw"][0], delta=0.5)
+
+    def test_the_plot_needs_a_configuration(self):
+        self.assertFailsCleanly(run_script(f"{self.run_dir}:{self.data}", "--plot",
+                                           Path(self.tmp.name) / "p"),
+                                "--plot draws a configuration's sigma bands")
 
     def test_the_replaced_reset_keys_are_named(self):
         config = Path(self.tmp.name) / "old_reset_keys.yaml"
