@@ -151,10 +151,20 @@ void Estimator::feedImu(double t, const Eigen::Vector3d& acc, const Eigen::Vecto
 
 void Estimator::consumeImuUpTo(double t) {
   while (!imu_queue_.empty() && imu_queue_.front().t() <= t) {
-    feedImu(imu_queue_.front().t(), imu_queue_.front().acc, imu_queue_.front().gyr);
+    const ImuSample& s = imu_queue_.front();
+    if (has_imu_ && s.t() - last_real_imu_t_ > options_.max_imu_gap_s)
+      imuMissing(s.t(), s.t() - last_real_imu_t_);
+    last_real_imu_t_ = s.t();
+    feedImu(s.t(), s.acc, s.gyr);
     imu_queue_.pop_front();
   }
   if (!has_imu_ || imu_time_ >= t) return;
+  // The frame lies in a gap: neither hold the last sample across it nor interpolate over it.
+  const double next = imu_queue_.empty() ? t : imu_queue_.front().t();
+  if (next - last_real_imu_t_ > options_.max_imu_gap_s) {
+    imuMissing(t, next - last_real_imu_t_);
+    return;
+  }
   // Close the interval exactly at the frame time: interpolate with the next sample, or hold
   // the last one when the next has not arrived.
   Eigen::Vector3d acc = acc_0_, gyr = gyr_0_;
@@ -165,6 +175,18 @@ void Estimator::consumeImuUpTo(double t) {
     gyr = (1 - w) * gyr_0_ + w * next.gyr;
   }
   feedImu(t, acc, gyr);
+}
+
+void Estimator::imuMissing(double t, double gap_s) {
+  char why[64];
+  std::snprintf(why, sizeof(why), "no IMU for %.2f s", gap_s);
+  if (frame_count_ > 0 || have_output_) {
+    reset(t, why);
+    warm_restart_armed_ = false;  // its dead reckoning guessed across the gap
+  } else {
+    logWarn(why, " at t=", stampText(t));
+  }
+  has_imu_ = false;
 }
 
 void Estimator::processImu(double dt, const Eigen::Vector3d& acc, const Eigen::Vector3d& gyr) {

@@ -64,6 +64,7 @@ EstimatorOptions EstimatorOptions::load(const YamlReader& yaml, const std::strin
   o.init_settle_max_s = yaml.getDouble(p + "init_settle_max_s", o.init_settle_max_s);
   o.warm_restart_max_s = yaml.getDouble(p + "warm_restart_max_s", o.warm_restart_max_s);
   o.warm_restart_min_points = yaml.getInt(p + "warm_restart_min_points", o.warm_restart_min_points);
+  o.max_imu_gap_s = yaml.getDouble(p + "max_imu_gap_s", o.max_imu_gap_s);
   o.init_min_excitation = yaml.getDouble(p + "init_min_excitation", o.init_min_excitation);
   o.init_accel_bias_sigma = yaml.getDouble(p + "init_accel_bias_sigma", o.init_accel_bias_sigma);
   o.init_gyro_bias_sigma = yaml.getDouble(p + "init_gyro_bias_sigma", o.init_gyro_bias_sigma);
@@ -89,6 +90,7 @@ EstimatorOptions EstimatorOptions::load(const YamlReader& yaml, const std::strin
     throw Error(yaml.where(p + "warm_restart_max_s") + " must not be negative (0: off)");
   if (o.warm_restart_min_points < 1)
     throw Error(yaml.where(p + "warm_restart_min_points") + " must be at least 1");
+  if (!(o.max_imu_gap_s > 0)) throw Error(yaml.where(p + "max_imu_gap_s") + " must be positive");
   if (o.num_threads < 1) throw Error(yaml.where(p + "num_threads") + " must be at least 1");
   if (o.point_sigma_px <= 0) throw Error(yaml.where(p + "point_sigma_px") + " must be positive");
   if (o.point_drift_px2_per_s < 0)

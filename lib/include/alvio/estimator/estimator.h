@@ -165,6 +165,9 @@ class Estimator {
   void feedImu(double t, const Eigen::Vector3d& acc, const Eigen::Vector3d& gyr);
   void processImu(double dt, const Eigen::Vector3d& acc, const Eigen::Vector3d& gyr);
   void consumeImuUpTo(double t);
+  /// More than max_imu_gap_s without IMU before `t`: reset, and integrate afresh from the next
+  /// sample.
+  void imuMissing(double t, double gap_s);
   void slideWindow();
   bool detectFailure(std::string* why) const;
   void reset(double t, const std::string& why);
@@ -251,7 +254,8 @@ class Estimator {
   // IMU stream.
   std::deque<ImuSample> imu_queue_;
   bool has_imu_ = false;
-  double imu_time_ = 0;  // time of the last sample fed to processImu
+  double imu_time_ = 0;         // time of the last sample fed to processImu
+  double last_real_imu_t_ = 0;  ///< the last sample fed, not one held or interpolated
   Eigen::Vector3d acc_0_ = Eigen::Vector3d::Zero(), gyr_0_ = Eigen::Vector3d::Zero();
   int64_t last_queued_imu_ns_ = 0;
   LogThrottle imu_late_, imu_nonfinite_;  // dropped samples, warned about once per 2 s

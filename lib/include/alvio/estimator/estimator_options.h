@@ -93,6 +93,10 @@ struct EstimatorOptions {
   /// observations to be placed. 0: always structure from motion.
   double warm_restart_max_s = 3.0;
   int warm_restart_min_points = 10;
+  /// No IMU sample for longer than this [s]: the window is reset instead of bridging the gap
+  /// by holding or interpolating samples, and restarts by structure from motion once the IMU
+  /// is back (the dead reckoning across the gap is only a constant-velocity guess).
+  double max_imu_gap_s = 1.0;
 
   // Failure detection (reset and re-initialise).
   int min_tracked_features = 3;  ///< fewer points + lines tracked into a frame: reset
