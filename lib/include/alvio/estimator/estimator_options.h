@@ -95,7 +95,7 @@ struct EstimatorOptions {
   int warm_restart_min_points = 10;
   /// No IMU sample for longer than this [s]: the window is reset instead of bridging the gap
   /// by holding or interpolating samples, and restarts by structure from motion once the IMU
-  /// is back (the dead reckoning across the gap is only a constant-velocity guess).
+  /// is back (the dead reckoning stops at the gap).
   double max_imu_gap_s = 1.0;
 
   // Failure detection (reset and re-initialise).
