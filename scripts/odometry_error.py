@@ -151,14 +151,23 @@ def load_reset_times(path):
     return np.sort(np.array(times))
 
 
+def outage_ends(errors):
+    """The index of the first pose after each outage."""
+    return np.flatnonzero(np.diff(errors["outages"]) > 0) + 1
+
+
 def outage_jumps(errors):
     """Per outage: (s after the first pose, its length: s from the last pose before it to the
     first after, resets in it, the position error's jump (m), the yaw error's (deg))."""
-    t, n = errors["t"], errors["outages"]
-    after = np.flatnonzero(np.diff(n) > 0) + 1
+    t = errors["t"]
     return [(t[i] - t[0], t[i] - t[i - 1], int(errors["resets"][i] - errors["resets"][i - 1]),
              float(np.linalg.norm(errors["position"][i] - errors["position"][i - 1])),
-             float(errors["yaw"][i] - errors["yaw"][i - 1])) for i in after]
+             float(errors["yaw"][i] - errors["yaw"][i - 1])) for i in outage_ends(errors)]
+
+
+def pooled(all_errors):
+    """The runs' errors end to end: one array per quantity."""
+    return {k: np.concatenate([r[k] for r in all_errors]) for k in all_errors[0]}
 
 
 def rms(x, axis=0):
@@ -208,9 +217,8 @@ def fit_growth(errors_sq, *columns, offset=None, weighted=False, iterations=50):
     return tuple(float(np.sqrt(c)) for c in coef)
 
 
-def fit(all_errors):
-    e = {k: np.concatenate([r[k] for r in all_errors]) for k in all_errors[0]}
-    n = len(e["path"])
+def fit(e):
+    """Every sigma, fitted on the pooled errors of the runs."""
     ones = np.ones_like(e["path"])
     s0 = fit_growth(np.square(e["position"]).reshape(-1),
                     *(np.repeat(x, 3) for x in (ones, e["path"] ** 2, e["outage_s2"],
@@ -224,13 +232,12 @@ def fit(all_errors):
         "outage_yaw_sigma_deg_per_s": y0[2],
         "velocity_sigma_mps": float(np.max(rms(e["velocity"]))),
         "angular_rate_sigma_rps": [float(x) for x in rms(e["rate"])],
-    }, n
+    }
 
 
-def fit_outages(all_errors, model):
-    """The outage sigmas alone, the model's path terms held: for runs with faults, once the
-    path terms were fitted on runs without."""
-    e = {k: np.concatenate([r[k] for r in all_errors]) for k in all_errors[0]}
+def fit_outages(e, model):
+    """The outage sigmas alone on the pooled errors, the model's path terms held: for runs with
+    faults, once the path terms were fitted on runs without."""
     d = e["path"]
     position_held = model["position_sigma_m"] ** 2 + (model["position_drift"] * d) ** 2
     yaw_held = model["yaw_sigma_deg"] ** 2 + (model["yaw_drift_deg_per_m"] * d) ** 2
@@ -340,7 +347,7 @@ def plot_run(model, errors, title):
     axes = fig.subplots(4, 1, sharex=True)
     rows = [(f"position {axis} (m)", errors["position"][:, k], sp)
             for k, axis in enumerate("xyz")] + [("yaw (deg)", errors["yaw"], sy)]
-    after = np.flatnonzero(np.diff(errors["outages"]) > 0) + 1
+    after = outage_ends(errors)
     for ax, (label, e, sigma) in zip(axes, rows):
         # Stepped: the sigma widens with the first pose after an outage, as it is published.
         ax.fill_between(t, -2 * sigma, 2 * sigma, step="post", color="tab:blue", alpha=0.12,
@@ -379,15 +386,17 @@ def main():
         fail("--plot draws a configuration's sigma bands: give it with --config")
     model = load_model(args.config) if args.config else None
     outage_min_s = model["outage_min_s"] if model else OUTAGE_MIN_S
+    runs = []
+    for spec in args.runs:
+        if ":" not in spec:
+            fail(f"'{spec}' is not RUN:DATASET")
+        runs.append(spec.split(":", 1))
     all_errors = []
     print("| run | poses | path (m) | outages | resets | position at the end (m) | "
           "yaw RMS (deg) | tilt RMS, larger axis (deg) | velocity RMS x/y/z (m/s) | "
           "angular rate RMS x/y/z (rad/s) |")
     print("|---|---|---|---|---|---|---|---|---|---|")
-    for spec in args.runs:
-        if ":" not in spec:
-            fail(f"'{spec}' is not RUN:DATASET")
-        run, dataset = spec.split(":", 1)
+    for run, dataset in runs:
         e = run_errors(run, dataset, outage_min_s)
         all_errors.append(e)
         velocity = " / ".join(f"{x:.4f}" for x in rms(e["velocity"]))
@@ -395,16 +404,19 @@ def main():
         print(f"| {run} | {len(e['path'])} | {e['path'][-1]:.1f} | {e['outages'][-1]} | "
               f"{e['resets'][-1]} | {np.linalg.norm(e['position'][-1]):.3f} | "
               f"{rms(e['yaw']):.3f} | {np.max(rms(e['tilt'])):.3f} | {velocity} | {rate} |")
-    fitted, n = fit(all_errors)
+    errors = pooled(all_errors)
     any_outage = any(e["outages"][-1] > 0 for e in all_errors)
     held = ""
     if args.outages_only:
         if not any_outage:
             fail("--outages-only: no run has an outage (a pause in the output over "
                  f"{outage_min_s:g} s) to fit them on")
-        fitted = fit_outages(all_errors, model)
+        fitted = fit_outages(errors, model)
         held = f", {args.config}'s position and yaw terms held"
-    print(f"\nFitted over {len(all_errors)} run(s), {n} poses{held}:\n\nodometry_covariance:")
+    else:
+        fitted = fit(errors)
+    print(f"\nFitted over {len(all_errors)} run(s), {len(errors['path'])} poses{held}:\n\n"
+          "odometry_covariance:")
     for k in KEYS:
         if k == "outage_min_s" or (k in OUTAGE_KEYS and not any_outage):
             continue  # a setting, not fitted; nothing to fit them on: noted below
@@ -417,25 +429,23 @@ def main():
         print(f"\nThe outages (pauses in the output over {outage_min_s:g} s): the error's jump "
               "across each\n\n| run | outage at (s after the first pose) | outage (s) | resets | "
               "position error's jump (m) | yaw error's jump (deg) |\n|---|---|---|---|---|---|")
-        for spec, e in zip(args.runs, all_errors):
+        for (run, _), e in zip(runs, all_errors):
             for at, length, resets, dp, dyaw in outage_jumps(e):
-                print(f"| {spec.split(':', 1)[0]} | {at:.2f} | {length:.2f} | {resets} | "
+                print(f"| {run} | {at:.2f} | {length:.2f} | {resets} | "
                       f"{dp:.4f} | {dyaw:+.3f} |")
     else:
         print(f"\n{', '.join(OUTAGE_KEYS)}: not fitted, as no run has an outage (a pause in the "
               f"output over {outage_min_s:g} s; keep your configuration's)")
     if model:
-        pooled = {k: np.concatenate([r[k] for r in all_errors]) for k in all_errors[0]}
         print(f"\n{args.config}'s sigmas: share of errors within 1 and 2 sigma "
               "(a Gaussian: 68 % / 95 %)\n")
         print("| component | within 1 sigma | within 2 sigma |\n|---|---|---|")
-        for name, (one, two) in coverage(model, pooled).items():
+        for name, (one, two) in coverage(model, errors).items():
             print(f"| {name} | {100 * one:.1f} % | {100 * two:.1f} % |")
     if args.plot:
         out = Path(args.plot)
         out.mkdir(parents=True, exist_ok=True)
-        for number, (spec, e) in enumerate(zip(args.runs, all_errors), 1):
-            run = spec.split(":", 1)[0]
+        for number, ((run, _), e) in enumerate(zip(runs, all_errors), 1):
             name = "_".join(part for part in Path(run).parts if part not in ("/", ".", ".."))
             png = out / f"{number}_{name}.png"
             plot_run(model, e, f"{run} against {Path(args.config).name}").savefig(png)

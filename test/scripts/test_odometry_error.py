@@ -21,7 +21,8 @@ from script_failures import CleanFailureAssertions
 SCRIPT = Path(__file__).resolve().parents[2] / "scripts" / "odometry_error.py"
 sys.path.insert(0, str(SCRIPT.parent))
 from odometry_error import (KEYS, coverage as model_coverage, fit_growth, fit_outages,  # noqa: E402
-                            normalised, plot_run, run_errors)
+                            load_model, normalised, plot_run, pooled, position_yaw_sigmas,
+                            run_errors)
 RATE_HZ, CAMERA_EVERY = 200, 10
 DURATION_S = 200.0
 SPEED, RADIUS = 1.0, 5.0              # m/s, m: a 200 m path
@@ -166,12 +167,17 @@ class FitGrowth(unittest.TestCase):
     long outage have errors 10x the others'."""
     S0, A, B = 0.01, 0.05, 0.004
 
+    def outages(self, rng):
+        """Each pose's outage length T (s), and the variance (a T)^2 + (b T^2)^2 it adds."""
+        t = np.where(np.arange(2000) < 1800, 1.0, 12.0) + rng.uniform(0, 0.5, 2000)
+        return t, (self.A * t) ** 2 + (self.B * t ** 2) ** 2
+
     def fits(self, weighted):
         out = []
         for seed in range(20):
             rng = np.random.default_rng(seed)
-            t = np.where(np.arange(2000) < 1800, 1.0, 12.0) + rng.uniform(0, 0.5, 2000)
-            var = self.S0 ** 2 + (self.A * t) ** 2 + (self.B * t ** 2) ** 2
+            t, outage_var = self.outages(rng)
+            var = self.S0 ** 2 + outage_var
             e = rng.normal(0.0, np.sqrt(var))
             out.append(fit_growth(e ** 2, np.ones_like(t), t ** 2, t ** 4, weighted=weighted))
         return np.array(out)
@@ -193,16 +199,15 @@ class FitGrowth(unittest.TestCase):
         errors = []
         for seed in range(20):
             rng = np.random.default_rng(100 + seed)
-            t = np.where(np.arange(2000) < 1800, 1.0, 12.0) + rng.uniform(0, 0.5, 2000)
+            t, outage_var = self.outages(rng)
             d = rng.uniform(0, 50, 2000)
-            var = (self.S0 ** 2 + (0.002 * d) ** 2 + (self.A * t) ** 2 +
-                   (self.B * t ** 2) ** 2)
+            var = self.S0 ** 2 + (0.002 * d) ** 2 + outage_var
             yaw_var = 0.05 ** 2 + (0.003 * d) ** 2 + (c * t) ** 2
             errors.append({"path": d, "position": rng.normal(0.0, np.sqrt(var)[:, None],
                                                              (2000, 3)),
                            "yaw": rng.normal(0.0, np.sqrt(yaw_var)), "outage_s2": t ** 2,
                            "outage_s4": t ** 4})
-        got = fit_outages(errors, model)
+        got = fit_outages(pooled(errors), model)
         for key, want in (("outage_position_sigma_mps", self.A),
                           ("outage_position_sigma_mps2", self.B),
                           ("outage_yaw_sigma_deg_per_s", c)):
@@ -367,8 +372,7 @@ class OdometryErrorTest(CleanFailureAssertions, unittest.TestCase):
             self.assertEqual(png.read_bytes()[:8], b"\x89PNG\r\n\x1a\n")
             self.assertGreater(png.stat().st_size, 30_000)
         # The figure itself: the errors drawn, the outages shaded, the share within 1 sigma.
-        import odometry_error
-        model = odometry_error.load_model(config)
+        model = load_model(config)
         errors = run_errors(self.reset_run, self.reset_data)
         fig = plot_run(model, errors, "run")
         axes = fig.axes
@@ -376,7 +380,7 @@ class OdometryErrorTest(CleanFailureAssertions, unittest.TestCase):
         t = errors["t"] - errors["t"][0]
         shares = model_coverage(model, errors)
         self.assertLess(shares["position"][0], 0.9)  # the share within 1 sigma is not all
-        sp, sy = odometry_error.position_yaw_sigmas(model, errors)
+        sp, sy = position_yaw_sigmas(model, errors)
         for k, ax in enumerate(axes):
             drawn = ax.lines[0].get_ydata()
             want = errors["position"][:, k] if k < 3 else errors["yaw"]
