@@ -33,6 +33,7 @@ Eigen::Vector2d get2(const Array& a) {
 void toMsg(const alvio::FeatureFrame& frame, const alvio::FrameTiming& timing,
            const std_msgs::Header& header, alvio::TrackedFeatures* msg) {
   msg->header = header;
+  msg->header.stamp = toRosTime(frame.t_ns);
   msg->points.resize(frame.points.size());
   for (std::size_t i = 0; i < frame.points.size(); ++i) {
     const auto& p = frame.points[i];

@@ -30,7 +30,8 @@ inline int64_t toNs(const ros::Time& t) {
 
 alvio::ImuSample fromMsg(const sensor_msgs::Imu& msg);
 
-/// The tracker's frame as a message; `header` is the image's.
+/// The tracker's frame as a message; `header` is the image's, its stamp replaced by the frame's
+/// time on the IMU's clock (camera.timeshift_cam_imu).
 void toMsg(const alvio::FeatureFrame& frame, const alvio::FrameTiming& timing,
            const std_msgs::Header& header, alvio::TrackedFeatures* msg);
 /// The estimator's input from the tracker's message (t_ns from the header stamp).

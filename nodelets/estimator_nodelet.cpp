@@ -253,7 +253,7 @@ class EstimatorNodelet : public GuardedNodelet {
     flushed_ = false;
 
     std_msgs::Header header;
-    header.stamp = features.header.stamp;  // the image's stamp
+    header.stamp = features.header.stamp;  // the image's time on the IMU's clock
     header.frame_id = world_frame_;
     if (has_pose) {
       const alvio::BodyState state = estimator_->latestState();

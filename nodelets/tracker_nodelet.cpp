@@ -125,7 +125,7 @@ class TrackerNodelet : public GuardedNodelet {
       track(pending, {});
       return;
     }
-    const int64_t t_ns = toNs(image->header.stamp);
+    const int64_t t_ns = config_.camera.imuClockNs(toNs(image->header.stamp));
     const std::size_t overflow_before = sync_.counts().frames_overflow;
     switch (sync_.addFrame(t_ns, std::move(pending))) {
       case alvio::FrameAdded::kQueued:
@@ -156,7 +156,7 @@ class TrackerNodelet : public GuardedNodelet {
   // `imu`: the samples that came since the previous image (none without the gyroscope's flow).
   void track(const PendingImage& pending, const std::vector<alvio::ImuSample>& imu) {
     const sensor_msgs::ImageConstPtr& image = pending.image;
-    const int64_t t_ns = toNs(image->header.stamp);
+    const int64_t t_ns = config_.camera.imuClockNs(toNs(image->header.stamp));
     if (alvio::clockJumpedBack(t_ns, last_t_ns_)) {
       // A bag played again, a restarted simulation, a clock reset: a new run.
       NODELET_WARN("image clock jumped back %.2f s: the front end starts afresh",

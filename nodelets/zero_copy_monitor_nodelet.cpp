@@ -56,21 +56,27 @@ class ZeroCopyMonitorNodelet : public GuardedNodelet {
 
   void onFrame(const SharedTrackedFrame::ConstPtr& frame) {
     ++report_.frames;
-    const int64_t stamp = toNs(frame->features.header.stamp);
-    const auto it = recent_.find(stamp);
-    if (!frame->image) {
+    if (!frame->image)
       ++report_.unmatched;
-    } else if (it != recent_.end()) {
+    else
+      match(frame);
+    report_pub_.publish(boost::make_shared<alvio::ZeroCopyReport>(report_));
+  }
+
+  void match(const SharedTrackedFrame::ConstPtr& frame) {
+    // The camera's stamp: the frame's own is on the IMU's clock (camera.timeshift_cam_imu).
+    const int64_t stamp = toNs(frame->image->header.stamp);
+    const auto it = recent_.find(stamp);
+    if (it != recent_.end()) {
       classify(*it->second, *frame->image);
       recent_.erase(recent_.begin(), std::next(it));
-    } else {
-      pending_[stamp] = frame;
-      while (pending_.size() > 30) {
-        pending_.erase(pending_.begin());
-        ++report_.unmatched;
-      }
+      return;
     }
-    report_pub_.publish(boost::make_shared<alvio::ZeroCopyReport>(report_));
+    pending_[stamp] = frame;
+    while (pending_.size() > 30) {
+      pending_.erase(pending_.begin());
+      ++report_.unmatched;
+    }
   }
 
   void classify(const sensor_msgs::Image& camera, const sensor_msgs::Image& in_frame) {

@@ -8,6 +8,8 @@
 
 namespace alvio {
 namespace {
+constexpr double kMaxTimeshiftS = 1.0;
+
 void requirePositive(double value, const std::string& where) {
   if (!(value > 0.0) || !std::isfinite(value)) {
     std::ostringstream os;
@@ -46,6 +48,7 @@ CameraOptions CameraOptions::load(const YamlReader& yaml, const std::string& pre
   o.distortion_coefficients = yaml.getDoubles(p + "distortion_coefficients");
   o.T_b_c = yaml.getTransform(p + "T_BS");
   o.rate_hz = yaml.getDouble(p + "rate_hz", o.rate_hz);
+  o.timeshift_cam_imu = yaml.getDouble(p + "timeshift_cam_imu", o.timeshift_cam_imu);
   // Descriptive keys of EuRoC sensor.yaml that carry no parameters.
   yaml.markKnown(p + "sensor_type");
   yaml.markKnown(p + "comment");
@@ -85,6 +88,17 @@ void CameraOptions::validate(const std::string& where) const {
     throw Error(os.str());
   }
   requirePositive(rate_hz, where + ".rate_hz");
+  // Beyond a second it is a clock offset, not a delay: stamp the images on the IMU's clock.
+  if (!(std::abs(timeshift_cam_imu) <= kMaxTimeshiftS)) {
+    std::ostringstream os;
+    os << where << ".timeshift_cam_imu must be within +-" << kMaxTimeshiftS << " s, got "
+       << timeshift_cam_imu;
+    throw Error(os.str());
+  }
+}
+
+int64_t CameraOptions::imuClockNs(int64_t camera_stamp_ns) const {
+  return camera_stamp_ns + static_cast<int64_t>(std::llround(timeshift_cam_imu * 1e9));
 }
 
 ImuOptions ImuOptions::load(const YamlReader& yaml, const std::string& prefix) {

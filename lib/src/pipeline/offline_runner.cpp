@@ -200,6 +200,8 @@ RunResult runOffline(SensorSource& source, const Config& config, const RunOption
   std::size_t images_seen = 0, images_of_old_clock = 0;
   bool started = options.start_s <= 0;
   while (!stopRequested() && source.next(&m)) {
+    // Images come stamped on the camera's clock; the pipeline runs on the IMU's.
+    if (m.kind == SensorMessage::Kind::kImage) m.t_ns = config.camera.imuClockNs(m.t_ns);
     if (!started) {
       if (first_ns < 0) first_ns = m.t_ns;
       if (m.t_ns < first_ns + secToNs(options.start_s)) continue;

@@ -2,6 +2,7 @@
 // Sensor calibration options, EuRoC-style (the keys of EuRoC's sensor.yaml).
 
 #include <Eigen/Geometry>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,12 @@ struct CameraOptions {
   /// Camera pose in the body (IMU) frame: EuRoC's T_BS.
   Eigen::Isometry3d T_b_c = Eigen::Isometry3d::Identity();
   double rate_hz = 20.0;
+  /// Kalibr's timeshift_cam_imu (s): an image stamped t_cam was taken at t_cam + shift on the
+  /// IMU's clock. The pipeline works on the IMU's clock, so its outputs are stamped on it.
+  double timeshift_cam_imu = 0.0;
+
+  /// The time of an image stamped `camera_stamp_ns`, on the IMU's clock.
+  int64_t imuClockNs(int64_t camera_stamp_ns) const;
 
   /// Read the keys under `prefix` ("camera"); throws alvio::Error naming the key.
   static CameraOptions load(const YamlReader& yaml, const std::string& prefix);
