@@ -30,9 +30,10 @@ config="$ROOT/config/euroc.yaml"
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --rate) rate="$2"; shift 2 ;;
-    --out) out="$2"; shift 2 ;;
-    --bag) bag="$2"; shift 2 ;;
-    --groundtruth) gt="$2"; shift 2 ;;
+    # Absolute: roslaunch runs the player and the nodelets in another working directory.
+    --out) out="$(realpath -m "$2")"; shift 2 ;;
+    --bag) bag="$(realpath -m "$2")"; shift 2 ;;
+    --groundtruth) gt="$(realpath -m "$2")"; shift 2 ;;
     --record-status) record_status=true; shift ;;
     --no-logging) logging=false; shift ;;
     --allocator) allocator="$2"; shift 2 ;;
