@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
 #include <sstream>
 #include <unordered_map>
 
@@ -157,18 +158,14 @@ std::optional<FrameRotation> rotationBetween(const FeatureFrame& first, const Fe
   const Eigen::Matrix3d rotation_only = alignBearings(a, b, use);
   cv::Mat R1, R2, t_cv;
   cv::decomposeEssentialMat(E, R1, R2, t_cv);
-  const auto toEigen = [](const cv::Mat& m) {
-    Eigen::Matrix3d R;
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) R(r, c) = m.at<double>(r, c);
-    return R;
-  };
+  Eigen::Matrix3d R1_c1_c0, R2_c1_c0;
+  cv::cv2eigen(R1, R1_c1_c0);
+  cv::cv2eigen(R2, R2_c1_c0);
   // OpenCV's R takes the first camera's points into the second's: R_c1_c0.
   const auto offBy = [&](const Eigen::Matrix3d& R_c1_c0) {
     return Eigen::AngleAxisd(rotation_only.transpose() * R_c1_c0.transpose()).angle();
   };
-  Eigen::Matrix3d R_c1_c0 = toEigen(R1);
-  if (offBy(toEigen(R2)) < offBy(R_c1_c0)) R_c1_c0 = toEigen(R2);
+  Eigen::Matrix3d R_c1_c0 = offBy(R2_c1_c0) < offBy(R1_c1_c0) ? R2_c1_c0 : R1_c1_c0;
   const Eigen::Vector3d t(t_cv.at<double>(0), t_cv.at<double>(1), t_cv.at<double>(2));
   R_c1_c0 = refinePose(xy0, xy1, R_c1_c0, t, inlier_threshold, &use);
   const int kept = static_cast<int>(std::count(use.begin(), use.end(), true));
