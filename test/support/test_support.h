@@ -23,6 +23,9 @@ std::string scratchDir();
 /// A scratch folder named `name` shared by the tests of this program, emptied on its first
 /// use and removed when the program exits.
 std::string sharedScratchDir(const std::string& name);
+/// A sequence rendered by alvio_sim with `sim_args` into the shared scratch folder `name`, once
+/// per program: the first call renders (a failure is a test failure), later calls return it.
+std::string renderedSequence(const std::string& name, const std::string& sim_args);
 /// Path of a file inside the source tree.
 std::string sourcePath(const std::string& relative);
 /// The message of the alvio::Error that `f` throws ("" and a test failure when it throws none).

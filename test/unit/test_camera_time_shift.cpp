@@ -27,31 +27,14 @@ std::string bin(const std::string& tool) {
 }
 
 // Rendered once for all the tests here (about 8 s on two cores).
-const std::string& sequence() {
-  static const std::string dir = [] {
-    const std::string d = test::sharedScratchDir("figure8");
-    std::string out;
-    if (test::runCommand(bin("alvio_sim") + "--trajectory figure8 --duration 8 --quiet --out " + d,
-                         &out) != 0)
-      ADD_FAILURE() << "alvio_sim failed:\n" << out;
-    return d;
-  }();
-  return dir;
+std::string sequence() {
+  return test::renderedSequence("figure8", "--trajectory figure8 --duration 8");
 }
 
 // 8 s of MH_03's flight, turning at 0.5 rad/s RMS: the figure eight turns at 0.19, too slowly
 // for the estimate (alvio_time_shift warns under 0.2).
-const std::string& turningSequence() {
-  static const std::string dir = [] {
-    const std::string d = test::sharedScratchDir("mh03");
-    std::string out;
-    if (test::runCommand(
-            bin("alvio_sim") + "--trajectory MH_03 --start 34 --duration 8 --quiet --out " + d,
-            &out) != 0)
-      ADD_FAILURE() << "alvio_sim failed:\n" << out;
-    return d;
-  }();
-  return dir;
+std::string turningSequence() {
+  return test::renderedSequence("mh03", "--trajectory MH_03 --start 34 --duration 8");
 }
 
 // The sequence with every image stamped `camera_late_ns` later (images, IMU and ground truth

@@ -19,16 +19,8 @@ std::string bin(const std::string& tool) {
 }
 
 // Rendered once for all the tests here (about 8 s on two cores).
-const std::string& sequence() {
-  static const std::string dir = [] {
-    const std::string d = test::sharedScratchDir("figure8");
-    std::string out;
-    if (test::runCommand(bin("alvio_sim") + "--trajectory figure8 --duration 8 --quiet --out " + d,
-                         &out) != 0)
-      ADD_FAILURE() << "alvio_sim failed:\n" << out;
-    return d;
-  }();
-  return dir;
+std::string sequence() {
+  return test::renderedSequence("figure8", "--trajectory figure8 --duration 8");
 }
 
 struct TruthRun {
