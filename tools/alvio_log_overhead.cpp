@@ -22,7 +22,7 @@
 #include "alvio/io/trajectory_io.h"
 #include "alvio/logging/run_logger.h"
 #include "alvio/pipeline/offline_runner.h"
-#include "rosbag_source.h"
+#include "dataset_source.h"
 
 using namespace alvio;
 
@@ -42,11 +42,7 @@ double cpuMs() {
 
 Measurement runOnce(const std::string& dataset, const Config& config, const std::string& out,
                     int max_frames, bool with_logger) {
-  std::unique_ptr<SensorSource> source;
-  if (std::filesystem::path(dataset).extension() == ".bag")
-    source = std::make_unique<RosbagSource>(dataset, config.topics);
-  else
-    source = std::make_unique<EurocSource>(dataset);
+  const std::unique_ptr<SensorSource> source = openDataset(dataset, config.topics);
   RunOptions options;
   options.out_dir = out;
   options.max_frames = max_frames;

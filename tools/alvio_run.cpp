@@ -4,7 +4,6 @@
 // SIGINT/SIGTERM stop the run early; everything processed so far is still written.
 #include <algorithm>
 #include <cstdlib>
-#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <string>
@@ -24,7 +23,7 @@
 #include "alvio/pipeline/analysis_writer.h"
 #include "alvio/pipeline/offline_runner.h"
 #include "alvio/pipeline/vio_pipeline.h"
-#include "rosbag_source.h"
+#include "dataset_source.h"
 
 #ifdef ALVIO_WITH_MIMALLOC
 #include <mimalloc.h>
@@ -110,12 +109,7 @@ int main(int argc, char** argv) {
         throw Error("--line-tracker must be flow or descriptor, got '" + config.lines.tracker +
                     "'");
     }
-    std::unique_ptr<SensorSource> source;
-    const std::string dataset = args.get("dataset");
-    if (std::filesystem::path(dataset).extension() == ".bag")
-      source = std::make_unique<RosbagSource>(dataset, config.topics);
-    else
-      source = std::make_unique<EurocSource>(dataset);
+    const std::unique_ptr<SensorSource> source = openDataset(args.get("dataset"), config.topics);
     RunOptions options;
     options.out_dir = args.get("out");
     options.max_frames = args.getInt("max-frames");

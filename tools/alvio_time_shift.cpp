@@ -4,7 +4,6 @@
 // is where the gyroscope's rotation over the same interval agrees best
 // (alvio/calibration/time_shift.h). Rotate the camera briskly about all its axes while
 // recording; translation and a constant gyroscope bias do not matter.
-#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <memory>
@@ -18,7 +17,7 @@
 #include "alvio/config/config.h"
 #include "alvio/pipeline/front_end.h"
 #include "alvio/pipeline/sensor_source.h"
-#include "rosbag_source.h"
+#include "dataset_source.h"
 
 using namespace alvio;
 
@@ -57,12 +56,7 @@ int main(int argc, char** argv) {
     // shift puts it. Lines add nothing to a rotation.
     config.points.gyro_flow = false;
     config.estimator.use_lines = false;
-    const std::string dataset = args.get("dataset");
-    std::unique_ptr<SensorSource> source;
-    if (std::filesystem::path(dataset).extension() == ".bag")
-      source = std::make_unique<RosbagSource>(dataset, config.topics);
-    else
-      source = std::make_unique<EurocSource>(dataset);
+    const std::unique_ptr<SensorSource> source = openDataset(args.get("dataset"), config.topics);
     const int max_frames = args.getInt("max-frames");
     const std::size_t total = max_frames > 0
                                   ? std::min<std::size_t>(max_frames, source->imageCount())
