@@ -108,13 +108,16 @@ std::string sharedScratchDir(const std::string& name) {
   return dir.string();
 }
 
+std::string tool(const std::string& name) {
+  return std::string(ALVIO_BIN_DIR) + "/" + name + " ";
+}
+
 std::string renderedSequence(const std::string& name, const std::string& sim_args) {
   static std::set<std::string> rendered;
   const std::string dir = sharedScratchDir(name);
   if (!rendered.insert(name).second) return dir;
   std::string out;
-  if (runCommand(std::string(ALVIO_BIN_DIR) + "/alvio_sim " + sim_args + " --quiet --out " + dir,
-                 &out) != 0)
+  if (runCommand(tool("alvio_sim") + sim_args + " --quiet --out " + dir, &out) != 0)
     ADD_FAILURE() << "alvio_sim " << sim_args << " failed:\n" << out;
   return dir;
 }

@@ -23,6 +23,8 @@ std::string scratchDir();
 /// A scratch folder named `name` shared by the tests of this program, emptied on its first
 /// use and removed when the program exits.
 std::string sharedScratchDir(const std::string& name);
+/// The path of one of alvio's programs followed by a space, to start a command line.
+std::string tool(const std::string& name);
 /// A sequence rendered by alvio_sim with `sim_args` into the shared scratch folder `name`, once
 /// per program: the first call renders (a failure is a test failure), later calls return it.
 std::string renderedSequence(const std::string& name, const std::string& sim_args);

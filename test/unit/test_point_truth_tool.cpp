@@ -14,10 +14,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string bin(const std::string& tool) {
-  return std::string(ALVIO_BIN_DIR) + "/" + tool + " ";
-}
-
 // Rendered once for all the tests here (about 8 s on two cores).
 std::string sequence() {
   return test::renderedSequence("figure8", "--trajectory figure8 --duration 8");
@@ -34,7 +30,8 @@ TruthRun runPointTruth(const std::string& args,
                        const std::string& config = test::sourcePath("config/euroc.yaml")) {
   TruthRun r;
   r.rc = test::runCommand(
-      bin("alvio_point_truth") + "--config " + config + " " + args + " " + sequence(), &r.output);
+      test::tool("alvio_point_truth") + "--config " + config + " " + args + " " + sequence(),
+      &r.output);
   std::smatch m;
   if (std::regex_search(r.output, m,
                         std::regex(R"(ATE ([0-9.]+) m; point error median ([0-9.]+) px)"))) {
@@ -95,7 +92,7 @@ TEST(PointTruthTool, OutWritesTheTrajectoryTheErrorsAndAMapThatMapTruthScores) {
   EXPECT_GT(readTrajectory(out + "/trajectory.tum").size(), 50u);
 
   std::string scored;
-  ASSERT_EQ(test::runCommand(bin("alvio_map_truth") + out + " " + sequence(), &scored), 0)
+  ASSERT_EQ(test::runCommand(test::tool("alvio_map_truth") + out + " " + sequence(), &scored), 0)
       << scored;
   std::smatch m;
   ASSERT_TRUE(
@@ -109,6 +106,6 @@ TEST(PointTruthTool, ASequenceWithoutRenderedTruthIsRefusedByName) {
   const std::string empty = test::scratchDir() + "/not_a_sequence";
   fs::create_directories(empty);
   std::string out;
-  EXPECT_NE(test::runCommand(bin("alvio_point_truth") + empty, &out), 0);
+  EXPECT_NE(test::runCommand(test::tool("alvio_point_truth") + empty, &out), 0);
   EXPECT_NE(out.find("not_a_sequence"), std::string::npos) << out;
 }
