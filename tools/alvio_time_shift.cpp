@@ -9,6 +9,7 @@
 #include <memory>
 #include <optional>
 
+#include "alvio/calibration/frame_rotation.h"
 #include "alvio/calibration/time_shift.h"
 #include "alvio/common/arg_parser.h"
 #include "alvio/common/error.h"
