@@ -24,7 +24,7 @@ using namespace alvio;
 
 namespace {
 
-// Below this the rotation barely moves within a shift's worth of time (EuRoC's flights: 0.3-0.9).
+// Below this the rotation barely moves within a shift's worth of time (MH_03's flight: 0.36).
 constexpr double kMinRmsRateRps = 0.2;
 constexpr int kMinPoints = 20;  // common to two images, for their rotation
 
@@ -58,6 +58,14 @@ int main(int argc, char** argv) {
     config.points.gyro_flow = false;
     config.estimator.use_lines = false;
     const std::unique_ptr<SensorSource> source = openDataset(args.get("dataset"), config.topics);
+    TimeShiftOptions options;
+    options.max_shift_s = args.getDouble("max-shift");
+    options.step_s = args.getDouble("step");
+    try {
+      options.validate();  // before the pass over the recording, not after it
+    } catch (const Error& e) {
+      throw Error(std::string("--max-shift / --step: ") + e.what());
+    }
     const int max_frames = args.getInt("max-frames");
     const std::size_t total = max_frames > 0
                                   ? std::min<std::size_t>(max_frames, source->imageCount())
@@ -90,17 +98,16 @@ int main(int argc, char** argv) {
       previous = std::move(frame);
       progress.update(images, std::to_string(rotations.size()) + " rotations");
     }
-    // The IMU a little past the last image: the last pairs need it at positive shifts.
-    while (source->next(&m))
+    // The IMU past the last image by the search's reach: the last pairs need it at positive
+    // shifts.
+    const int64_t last_image_ns = m.t_ns;
+    while (source->next(&m) && m.t_ns <= last_image_ns + secToNs(options.max_shift_s + 0.1))
       if (m.kind == SensorMessage::Kind::kImu) imu.push_back(m.imu);
     progress.finish();
     if (unreadable > 0)
       logWarn(unreadable, " images could not be read or are not ", config.camera.width, "x",
               config.camera.height, " (camera.resolution): skipped");
 
-    TimeShiftOptions options;
-    options.max_shift_s = args.getDouble("max-shift");
-    options.step_s = args.getDouble("step");
     const TimeShiftEstimate e =
         estimateTimeShift(rotations, imu, config.camera.T_b_c.rotation(), options);
     if (args.isSet("curve")) writeCurve(args.get("curve"), e);

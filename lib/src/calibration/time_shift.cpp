@@ -48,15 +48,19 @@ class GyroIntegral {
 
 }  // namespace
 
+void TimeShiftOptions::validate() const {
+  if (!(max_shift_s > 0 && max_shift_s <= 1.0))
+    throw Error("time shift: the search must reach a shift in (0, 1] s, got " +
+                std::to_string(max_shift_s));
+  if (!(step_s > 0 && step_s <= max_shift_s / 2))
+    throw Error("time shift: the step must be in (0, max shift / 2], got " +
+                std::to_string(step_s));
+}
+
 TimeShiftEstimate estimateTimeShift(const std::vector<FrameRotation>& rotations,
                                     const std::vector<ImuSample>& imu, const Eigen::Matrix3d& R_b_c,
                                     const TimeShiftOptions& options) {
-  if (!(options.max_shift_s > 0 && options.max_shift_s <= 1.0))
-    throw Error("time shift: the search must reach a shift in (0, 1] s, got " +
-                std::to_string(options.max_shift_s));
-  if (!(options.step_s > 0 && options.step_s <= options.max_shift_s / 2))
-    throw Error("time shift: the step must be in (0, max shift / 2], got " +
-                std::to_string(options.step_s));
+  options.validate();
   if (imu.size() < 2) throw Error("time shift: fewer than 2 IMU samples");
   const GyroIntegral gyro(imu);
   const Eigen::Matrix3d R_c_b = R_b_c.transpose();

@@ -17,6 +17,8 @@ namespace alvio {
 struct TimeShiftOptions {
   double max_shift_s = 0.2;  ///< trial shifts from -max to +max
   double step_s = 0.001;     ///< between trial shifts; the minimum is refined between them
+  /// Throws alvio::Error naming the option out of range.
+  void validate() const;
 };
 
 struct TimeShiftEstimate {
