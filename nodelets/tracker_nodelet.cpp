@@ -120,6 +120,14 @@ class TrackerNodelet : public GuardedNodelet {
                              config_.camera.height);
       return;
     }
+    // A camera stamped late by the shift, on a clock that starts at 0 (simulated time).
+    if (config_.camera.imuClockNs(toNs(image->header.stamp)) <= 0) {
+      NODELET_WARN_THROTTLE(5.0,
+                            "image at %.3f s comes before 0 s on the IMU's clock "
+                            "(camera.timeshift_cam_imu %.3f s): skipped",
+                            image->header.stamp.toSec(), config_.camera.timeshift_cam_imu);
+      return;
+    }
     PendingImage pending{image, gray, received};
     if (!uses_gyro_) {
       track(pending, {});

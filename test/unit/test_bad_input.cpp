@@ -39,11 +39,11 @@ std::string configReplacing(const std::string& dir, const std::string& from,
 
 // A small EuRoC folder: `count` textured images of width x height at 20 Hz and a still,
 // level IMU at 200 Hz over the same time.
-std::string makeEurocFolder(const std::string& root, int count, int width, int height) {
+std::string makeEurocFolder(const std::string& root, int count, int width, int height,
+                            int64_t t0 = 1'000'000'000'000) {
   const fs::path cam = fs::path(root) / "mav0" / "cam0";
   fs::create_directories(cam / "data");
   fs::create_directories(fs::path(root) / "mav0" / "imu0");
-  const int64_t t0 = 1'000'000'000'000;
   std::vector<int64_t> stamps;
   std::mt19937 rng(7);
   for (int i = 0; i < count; ++i) {
@@ -219,6 +219,18 @@ TEST(BadDataset, TruncatedPngIsSkippedAndCounted) {
   const auto summary = nlohmann::json::parse(test::readFile(dir + "/out/summary.json"));
   EXPECT_EQ(summary["skipped_images"], 2);
   EXPECT_EQ(summary["frames"], 3);
+}
+
+TEST(BadDataset, ImagesShiftedBeforeTheClocksZeroAreSkippedAndCounted) {
+  // Images from 0.12 s on a clock that starts at 0 (simulated time), stamped 0.2 s late.
+  const std::string dir = test::scratchDir();
+  const std::string data = makeEurocFolder(dir + "/data", 5, 752, 480, 120'000'000);
+  Config config = defaultConfig();
+  config.camera.timeshift_cam_imu = -0.2;
+  EurocSource source(data);
+  const RunResult r = runOffline(source, config, quietRun(dir + "/out"));
+  EXPECT_EQ(r.skipped_images, 2u);  // at -0.08 and -0.03 s on the IMU's clock
+  EXPECT_EQ(r.frames, 3u);
 }
 
 // --- starting mid-way ---------------------------------------------------------------------

@@ -201,7 +201,15 @@ RunResult runOffline(SensorSource& source, const Config& config, const RunOption
   bool started = options.start_s <= 0;
   while (!stopRequested() && source.next(&m)) {
     // Images come stamped on the camera's clock; the pipeline runs on the IMU's.
-    if (m.kind == SensorMessage::Kind::kImage) m.t_ns = config.camera.imuClockNs(m.t_ns);
+    if (m.kind == SensorMessage::Kind::kImage) {
+      m.t_ns = config.camera.imuClockNs(m.t_ns);
+      // A camera stamped late by the shift, on a clock that starts at 0 (simulated time).
+      if (m.t_ns <= 0) {
+        ++result.skipped_images;
+        logWarn("image at ", m.t_ns, " ns on the IMU's clock (camera.timeshift_cam_imu): skipped");
+        continue;
+      }
+    }
     if (!started) {
       if (first_ns < 0) first_ns = m.t_ns;
       if (m.t_ns < first_ns + secToNs(options.start_s)) continue;
