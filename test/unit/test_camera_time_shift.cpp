@@ -30,7 +30,7 @@ std::string sequence() {
 
 // 8 s of the camera turning about every axis at 0.6-0.9 rad/s while it drifts a little, where
 // the demo's figure eight starts: the figure eight itself turns at 0.19 rad/s RMS, too slowly
-// for the estimate (alvio_time_shift warns under 0.2). Built in, so that no shared data is needed.
+// for the estimate (alvio_time_shift warns under 0.2). Written here: MH_03 needs the shared data.
 std::string turningSequence() {
   static const std::string trajectory = [] {
     std::ostringstream tum;
