@@ -8,22 +8,25 @@
 #include <opencv2/core/eigen.hpp>
 #include <unordered_map>
 
+#include "alvio/common/rotation.h"
+
 namespace alvio {
 namespace {
 
 // Beyond this apart, the essential matrix's rotation is the twisted pair, or the fit degenerate.
 constexpr double kMaxDisagreementRad = 0.1;
 
-Eigen::Vector3d bearing(const Eigen::Vector2d& xy) {
-  return Eigen::Vector3d(xy.x(), xy.y(), 1.0).normalized();
+Eigen::Vector3d bearing(const cv::Point2d& xy) {
+  return Eigen::Vector3d(xy.x, xy.y, 1.0).normalized();
 }
 
-// R minimising sum |a_i - R b_i|^2 (Kabsch), over the pairs marked in `use`.
-Eigen::Matrix3d alignBearings(const std::vector<Eigen::Vector3d>& a,
-                              const std::vector<Eigen::Vector3d>& b, const std::vector<bool>& use) {
+// R minimising sum |a_i - R b_i|^2 over the bearings a_i of xy0 and b_i of xy1 (Kabsch), over
+// the pairs marked in `use`.
+Eigen::Matrix3d alignBearings(const std::vector<cv::Point2d>& xy0,
+                              const std::vector<cv::Point2d>& xy1, const std::vector<bool>& use) {
   Eigen::Matrix3d M = Eigen::Matrix3d::Zero();
-  for (std::size_t i = 0; i < a.size(); ++i)
-    if (use[i]) M += a[i] * b[i].transpose();
+  for (std::size_t i = 0; i < xy0.size(); ++i)
+    if (use[i]) M += bearing(xy0[i]) * bearing(xy1[i]).transpose();
   const Eigen::JacobiSVD<Eigen::Matrix3d> svd(M, Eigen::ComputeFullU | Eigen::ComputeFullV);
   Eigen::Matrix3d D = Eigen::Matrix3d::Identity();
   D(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0 ? -1.0 : 1.0;
@@ -81,11 +84,6 @@ Eigen::Matrix3d refinePose(const std::vector<cv::Point2d>& xy0, const std::vecto
   return q.normalized().toRotationMatrix();
 }
 
-Eigen::Vector3d rotationVector(const Eigen::Matrix3d& R) {
-  const Eigen::AngleAxisd aa(R);
-  return aa.angle() * aa.axis();
-}
-
 }  // namespace
 
 std::optional<FrameRotation> rotationBetween(const FeatureFrame& first, const FeatureFrame& second,
@@ -93,29 +91,26 @@ std::optional<FrameRotation> rotationBetween(const FeatureFrame& first, const Fe
   std::unordered_map<int, const PointObservation*> by_id;
   for (const PointObservation& p : first.points) by_id[p.id] = &p;
   std::vector<cv::Point2d> xy0, xy1;
-  std::vector<Eigen::Vector3d> a, b;
   for (const PointObservation& p : second.points) {
     const auto it = by_id.find(p.id);
     if (it == by_id.end()) continue;
     xy0.emplace_back(it->second->xy.x(), it->second->xy.y());
     xy1.emplace_back(p.xy.x(), p.xy.y());
-    a.push_back(bearing(it->second->xy));
-    b.push_back(bearing(p.xy));
   }
   const std::size_t needed = static_cast<std::size_t>(std::max(min_points, 5));
-  if (a.size() < needed) return std::nullopt;
+  if (xy0.size() < needed) return std::nullopt;
   // The essential matrix, so that the translation's parallax does not pass for rotation; with
   // little translation its rotation stays determined (any translation fits a pure rotation).
   cv::Mat inliers;
   const cv::Mat E = cv::findEssentialMat(xy0, xy1, cv::Mat::eye(3, 3, CV_64F), cv::RANSAC, 0.999,
                                          inlier_threshold, inliers);
   if (E.rows != 3 || E.cols != 3) return std::nullopt;  // several solutions stacked: ambiguous
-  std::vector<bool> use(a.size(), false);
-  for (std::size_t i = 0; i < a.size(); ++i) use[i] = inliers.at<uchar>(static_cast<int>(i)) != 0;
+  std::vector<bool> use(xy0.size(), false);
+  for (std::size_t i = 0; i < xy0.size(); ++i) use[i] = inliers.at<uchar>(static_cast<int>(i)) != 0;
   // Of its two rotations (the other is twisted by half a turn about the translation), the one
   // nearest the rotation that explains the same points without translation. Not by cheirality:
   // at 20 Hz most points are too far for the baseline to put in front of either camera.
-  const Eigen::Matrix3d rotation_only = alignBearings(a, b, use);
+  const Eigen::Matrix3d rotation_only = alignBearings(xy0, xy1, use);
   cv::Mat R1, R2, t_cv;
   cv::decomposeEssentialMat(E, R1, R2, t_cv);
   Eigen::Matrix3d R1_c1_c0, R2_c1_c0;
@@ -130,11 +125,10 @@ std::optional<FrameRotation> rotationBetween(const FeatureFrame& first, const Fe
   R_c1_c0 = refinePose(xy0, xy1, R_c1_c0, t, inlier_threshold, &use);
   const int kept = static_cast<int>(std::count(use.begin(), use.end(), true));
   if (kept < static_cast<int>(needed) || offBy(R_c1_c0) > kMaxDisagreementRad) return std::nullopt;
-  const Eigen::Matrix3d R_c0_c1 = R_c1_c0.transpose();
   FrameRotation r;
   r.t0_ns = first.t_ns;
   r.t1_ns = second.t_ns;
-  r.rotation = rotationVector(R_c0_c1);
+  r.rotation = logQuaternion(Eigen::Quaterniond(R_c1_c0.transpose()));  // R_c0_c1
   r.points = kept;
   return r;
 }

@@ -5,46 +5,15 @@
 #include <sstream>
 
 #include "alvio/common/error.h"
+#include "alvio/common/rotation.h"
+#include "alvio/frontend/gyro_rotation.h"
 
 namespace alvio {
 namespace {
 
-constexpr double kMaxPairGapS = 0.2;  // longer: the rotation vector no longer adds up linearly
+// Longer: a constant bias no longer makes a constant difference of the rotation vectors' rates.
+constexpr double kMaxPairGapS = 0.2;
 constexpr std::size_t kMinPairs = 20;
-
-// The gyroscope's integral from its first sample, at any time inside its span: the rate
-// linear between samples.
-class GyroIntegral {
- public:
-  explicit GyroIntegral(const std::vector<ImuSample>& imu) : imu_(imu) {
-    cumulative_.assign(imu.size(), Eigen::Vector3d::Zero());
-    for (std::size_t i = 1; i < imu.size(); ++i)
-      cumulative_[i] = cumulative_[i - 1] + 0.5 * (imu[i - 1].gyr + imu[i].gyr) * seconds(i - 1, i);
-  }
-  double first() const { return relative(imu_.front().t_ns); }
-  double last() const { return relative(imu_.back().t_ns); }
-  /// Seconds since the first sample.
-  double relative(int64_t t_ns) const {
-    return static_cast<double>(t_ns - imu_.front().t_ns) * 1e-9;
-  }
-  Eigen::Vector3d at(double t) const {
-    std::size_t i = static_cast<std::size_t>(
-        std::upper_bound(imu_.begin(), imu_.end(), t,
-                         [&](double v, const ImuSample& s) { return v < relative(s.t_ns); }) -
-        imu_.begin());
-    i = std::clamp<std::size_t>(i, 1, imu_.size() - 1) - 1;
-    const double h = seconds(i, i + 1), tau = t - relative(imu_[i].t_ns);
-    const Eigen::Vector3d slope = (imu_[i + 1].gyr - imu_[i].gyr) / h;
-    return cumulative_[i] + imu_[i].gyr * tau + 0.5 * slope * tau * tau;
-  }
-
- private:
-  double seconds(std::size_t i, std::size_t j) const {
-    return static_cast<double>(imu_[j].t_ns - imu_[i].t_ns) * 1e-9;
-  }
-  const std::vector<ImuSample>& imu_;
-  std::vector<Eigen::Vector3d> cumulative_;
-};
 
 }  // namespace
 
@@ -62,18 +31,19 @@ TimeShiftEstimate estimateTimeShift(const std::vector<FrameRotation>& rotations,
                                     const TimeShiftOptions& options) {
   options.validate();
   if (imu.size() < 2) throw Error("time shift: fewer than 2 IMU samples");
-  const GyroIntegral gyro(imu);
-  const Eigen::Matrix3d R_c_b = R_b_c.transpose();
+  GyroRotation gyro(R_b_c);
+  for (const ImuSample& s : imu) gyro.add(s);
+  const int64_t reach_ns = secToNs(options.max_shift_s);
 
   // Only the pairs inside the IMU's span at every trial: each trial is scored on the same data.
   std::vector<const FrameRotation*> pairs;
   double sum_sq_rate = 0;
   for (const FrameRotation& r : rotations) {
-    const double t0 = gyro.relative(r.t0_ns), t1 = gyro.relative(r.t1_ns);
-    if (!(t1 > t0) || t1 - t0 > kMaxPairGapS) continue;
-    if (t0 - options.max_shift_s < gyro.first() || t1 + options.max_shift_s > gyro.last()) continue;
+    const double dt = nsToSec(r.t1_ns - r.t0_ns);
+    if (!(dt > 0) || dt > kMaxPairGapS) continue;
+    if (!gyro.cameraRotation(r.t0_ns - reach_ns, r.t1_ns + reach_ns)) continue;
     pairs.push_back(&r);
-    sum_sq_rate += r.rotation.squaredNorm() / ((t1 - t0) * (t1 - t0));
+    sum_sq_rate += r.rotation.squaredNorm() / (dt * dt);
   }
   if (pairs.size() < kMinPairs) {
     std::ostringstream os;
@@ -92,10 +62,13 @@ TimeShiftEstimate estimateTimeShift(const std::vector<FrameRotation>& rotations,
     std::vector<Eigen::Vector3d> residuals;
     residuals.reserve(pairs.size());
     Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    const int64_t shift_ns = secToNs(shift);
     for (const FrameRotation* r : pairs) {
-      const double t0 = gyro.relative(r->t0_ns) + shift, t1 = gyro.relative(r->t1_ns) + shift;
-      const Eigen::Vector3d gyro_rotation = R_c_b * (gyro.at(t1) - gyro.at(t0));
-      residuals.push_back((gyro_rotation - r->rotation) / (t1 - t0));
+      // R_c1_c0 from the gyroscope; the pair's rotation is R_c0_c1's.
+      const Eigen::Matrix3d R_c1_c0 =
+          *gyro.cameraRotation(r->t0_ns + shift_ns, r->t1_ns + shift_ns);
+      const Eigen::Vector3d gyro_rotation = logQuaternion(Eigen::Quaterniond(R_c1_c0.transpose()));
+      residuals.push_back((gyro_rotation - r->rotation) / nsToSec(r->t1_ns - r->t0_ns));
       mean += residuals.back();
     }
     mean /= static_cast<double>(pairs.size());

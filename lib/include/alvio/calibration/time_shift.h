@@ -1,6 +1,6 @@
 #pragma once
 // The camera-to-IMU time shift from a recording alone (no calibration target): the camera's
-// rotation between consecutive images, from its tracked points' bearings, compared with the
+// rotation between consecutive images, from its tracked points (frame_rotation.h), against the
 // gyroscope's over the same interval moved by each trial shift. Where they agree best is
 // Kalibr's timeshift_cam_imu (t_imu = t_cam + shift). A constant gyroscope bias is taken out
 // at every trial, so it does not pull the estimate.
