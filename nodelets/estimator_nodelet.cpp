@@ -281,6 +281,7 @@ class EstimatorNodelet : public GuardedNodelet {
     status->window_lines = static_cast<int32_t>(estimator_->lineSegments().size());
     status->frontend_ms = features.stats.total_ms;
     status->estimator_ms = estimator_ms;
+    status->time_shift_s = estimator_->timeShift();
     status->latency_ms =
         features.received.isZero()
             ? -1.0  // a sender that does not fill it in

@@ -4,6 +4,7 @@
 // SIGINT/SIGTERM stop the run early; everything processed so far is still written.
 #include <algorithm>
 #include <cstdlib>
+#include <iomanip>
 #include <iostream>
 #include <memory>
 #include <string>
@@ -140,6 +141,12 @@ int main(int argc, char** argv) {
     if (r.dropped_images + r.dropped_imu > 0)
       std::cout << "dropped (out of order or not finite): " << r.dropped_images << " images, "
                 << r.dropped_imu << " IMU samples\n";
+    if (r.estimated_time_shift_s)
+      std::cout << "camera time shift estimated: " << std::showpos << std::fixed
+                << std::setprecision(2) << 1e3 * *r.estimated_time_shift_s << std::noshowpos
+                << " ms on top of camera.timeshift_cam_imu (for the config: timeshift_cam_imu: "
+                << std::setprecision(4)
+                << config.camera.timeshift_cam_imu + *r.estimated_time_shift_s << ")\n";
     if (r.initialization) {
       const auto& q = *r.initialization;
       std::cout << "initialised at " << std::fixed << q.time << " s (" << q.since_motion_s

@@ -99,9 +99,9 @@ void expectCompleteOutputs(const std::string& out) {
   EXPECT_EQ(static_cast<std::size_t>(std::count(timing.begin(), timing.end(), '\n')), frames + 1);
   const std::string trajectory = test::readFile(out + "/trajectory.tum");
   EXPECT_EQ(trajectory.rfind("# timestamp", 0), 0u);
-  // states.csv: velocity and biases, a header and a row per pose of the trajectory.
+  // states.csv: velocity, biases and time shift, a header and a row per pose of the trajectory.
   const std::string states = test::readFile(out + "/states.csv");
-  EXPECT_EQ(states.rfind("t,vx,vy,vz,bax,bay,baz,bgx,bgy,bgz\n", 0), 0u);
+  EXPECT_EQ(states.rfind("t,vx,vy,vz,bax,bay,baz,bgx,bgy,bgz,time_shift_s\n", 0), 0u);
   EXPECT_EQ(std::count(states.begin(), states.end(), '\n'),
             std::count(trajectory.begin(), trajectory.end(), '\n'));
   mrpt::obs::CRawlog rawlog;

@@ -66,6 +66,44 @@ TEST(PointProjectionFactor, AnalyticJacobiansMatchNumeric) {
   }
 }
 
+TEST(PointProjectionFactor, TimeShiftJacobianMatchesNumeric) {
+  const Eigen::Isometry3d T_b_c = eurocTbc();
+  for (int trial = 0; trial < 20; ++trial) {
+    double pose_i[7], pose_j[7], inv_depth[1], td[1] = {uniform(-0.05, 0.05)};
+    setPose(pose_i, randomVector(2), randomRotation());
+    const Eigen::Quaterniond qj =
+        Eigen::Map<Eigen::Quaterniond>(pose_i + 3) * expQuaternion(randomVector(0.2));
+    setPose(pose_j, Eigen::Map<Eigen::Vector3d>(pose_i) + randomVector(0.3), qj);
+    inv_depth[0] = uniform(0.1, 0.5);
+    PointProjectionFactor f({uniform(-0.4, 0.4), uniform(-0.3, 0.3)}, {uniform(-0.4, 0.4), 0.1},
+                            T_b_c, 460.0 / 1.5);
+    f.estimateTimeShift(randomVector(0.5).head<2>(), randomVector(0.5).head<2>());
+    ASSERT_EQ(f.parameter_block_sizes().size(), 4u);
+    const auto check = test::checkJacobians(f, {pose_i, pose_j, inv_depth, td});
+    EXPECT_LT(check.max_rel_error, 1e-5) << "trial " << trial;
+  }
+}
+
+TEST(PointProjectionFactor, TimeShiftMovesTheObservationsAlongTheirVelocities) {
+  // td later than the stamp: the frame's pose saw each point td * velocity before where the
+  // image shows it, so the factor at td equals the plain one at the moved observations.
+  const Eigen::Isometry3d T_b_c = eurocTbc();
+  double pose_i[7], pose_j[7], inv_depth[1] = {0.3}, td[1] = {0.03};
+  setPose(pose_i, {0.1, 0.2, 0.3}, randomRotation());
+  setPose(pose_j, {0.3, 0.1, 0.2}, Eigen::Map<Eigen::Quaterniond>(pose_i + 3));
+  const Eigen::Vector2d obs_i(0.1, -0.2), obs_j(0.05, 0.1), vel_i(0.4, -0.1), vel_j(-0.3, 0.2);
+  PointProjectionFactor shifted(obs_i, obs_j, T_b_c, 300.0);
+  shifted.estimateTimeShift(vel_i, vel_j);
+  const PointProjectionFactor moved(obs_i - td[0] * vel_i, obs_j - td[0] * vel_j, T_b_c, 300.0);
+  double r_shifted[2], r_moved[2];
+  const double* with_td[4] = {pose_i, pose_j, inv_depth, td};
+  ASSERT_TRUE(shifted.Evaluate(with_td, r_shifted, nullptr));
+  ASSERT_TRUE(moved.Evaluate(with_td, r_moved, nullptr));
+  EXPECT_NEAR(r_shifted[0], r_moved[0], 1e-9);
+  EXPECT_NEAR(r_shifted[1], r_moved[1], 1e-9);
+  EXPECT_GT(std::abs(r_shifted[0] - 0.0) + std::abs(r_shifted[1]), 0.0);
+}
+
 TEST(PointProjectionFactor, ZeroResidualAtTruth) {
   const Eigen::Isometry3d T_b_c = eurocTbc();
   const Eigen::Vector3d p_w(2, 1, 5);

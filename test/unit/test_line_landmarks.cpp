@@ -307,3 +307,27 @@ TEST(LineLandmarks, ResidualsOnEdgesTakeTheEdgePositionsAndSkipFramesWhereTheEdg
       EXPECT_NEAR(off, 0.03, 0.005);
   }
 }
+
+TEST(LineLandmarks, EndpointVelocitiesAreTheLinesMotionAcrossItself) {
+  // A horizontal line moving down 0.01 per 50 ms while its detected ends slide along it: each
+  // endpoint's velocity is the line's, 0.2 per second down, whatever the slide. The first
+  // observation, which has no previous one, takes the second's.
+  LineLandmarks lines(3, LineTriangulationOptions{});
+  const auto frame = [](double y, double slide) {
+    std::vector<LineObservation, Eigen::aligned_allocator<LineObservation>> obs(1);
+    obs[0].id = 5;
+    obs[0].start_norm = {-0.3 + slide, y};
+    obs[0].end_norm = {0.2 - 2 * slide, y};
+    return obs;
+  };
+  lines.addFrame(1'000'000'000, frame(0.10, 0.0));
+  lines.addFrame(1'050'000'000, frame(0.11, 0.04));
+  const auto& observations = lines.landmarks().at(5).observations;
+  const LineLandmarkObservation& first = observations.begin()->second;
+  const LineLandmarkObservation& second = observations.rbegin()->second;
+  for (const Eigen::Vector2d& v :
+       {first.start_velocity, first.end_velocity, second.start_velocity, second.end_velocity}) {
+    EXPECT_NEAR(v.x(), 0.0, 1e-12);
+    EXPECT_NEAR(v.y(), 0.2, 1e-9);
+  }
+}

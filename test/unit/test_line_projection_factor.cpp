@@ -115,6 +115,38 @@ TEST(LineProjectionFactor, AmbientJacobiansMatchNumeric) {
   }
 }
 
+TEST(LineProjectionFactor, TimeShiftJacobianMatchesNumericAndMovesTheEndpoints) {
+  std::mt19937 rng(21);
+  for (int k = 0; k < 30; ++k) {
+    const Scene sc = randomScene(rng, 0.02);
+    const Eigen::Vector2d v_s = test::randomVector(rng, 0.5).head<2>();
+    const Eigen::Vector2d v_e = test::randomVector(rng, 0.5).head<2>();
+    LineProjectionFactor f(sc.s, sc.e, sc.T_b_c, 300.0);
+    f.estimateTimeShift(v_s, v_e);
+    const double td = 0.04 * (k % 3 - 1);
+    double residuals[2];
+    Eigen::Matrix<double, 2, 7, Eigen::RowMajor> J_pose;
+    Eigen::Matrix<double, 2, 4, Eigen::RowMajor> J_line;
+    Eigen::Vector2d J_td;
+    double* jacobians[3] = {J_pose.data(), J_line.data(), J_td.data()};
+    const double* params[3] = {sc.pose, sc.line, &td};
+    ASSERT_TRUE(f.Evaluate(params, residuals, jacobians));
+    const Eigen::MatrixXd J_td_num = numericJacobian(
+        [&](const Eigen::VectorXd& x) -> Eigen::VectorXd {
+          Eigen::Vector2d r;
+          EXPECT_TRUE(f.residual(sc.pose, sc.line, &r, x[0]));
+          return r;
+        },
+        Eigen::VectorXd::Constant(1, td));
+    EXPECT_LT((J_td_num - J_td).norm(), 1e-6 * (1.0 + J_td_num.norm())) << J_td.transpose();
+    // The same as the plain factor at the moved endpoints.
+    const LineProjectionFactor moved(sc.s - td * v_s, sc.e - td * v_e, sc.T_b_c, 300.0);
+    EXPECT_LT(
+        (evaluate(moved, sc.pose, sc.line) - Eigen::Vector2d(residuals[0], residuals[1])).norm(),
+        1e-9);
+  }
+}
+
 TEST(LineProjectionFactor, TangentJacobiansMatchNumericThroughTheManifolds) {
   // What the solver sees: J_ambient * PlusJacobian against d r(Plus(x, delta)) / d delta.
   std::mt19937 rng(13);

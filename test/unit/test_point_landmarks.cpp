@@ -161,3 +161,18 @@ TEST(PointLandmarks, EveryLandmarkIsTriangulatedFromItsOwnFirstCamera) {
   landmarks.retriangulate(P, R, T_b_c, [](const PointLandmark&) { return true; });
   expectTrueDepths("retriangulate");
 }
+
+TEST(PointLandmarks, ANewTracksFirstSightingTakesTheVelocityOfItsSecond) {
+  // The front end knows no velocity for a point in its first frame; the time shift's estimate
+  // needs one for every sighting, the anchor above all.
+  PointLandmarks landmarks(10, kMinParallax);
+  FeatureFrame first = pointsAt(0, 2, 0.0), second = pointsAt(0, 2, 0.01);
+  for (PointObservation& o : second.points) o.velocity = {0.2, -0.1};
+  second.points[1].velocity = Eigen::Vector2d::Zero();  // a still point stays still
+  landmarks.addFrameAndCheckParallax(0, first);
+  landmarks.addFrameAndCheckParallax(1, second);
+  const PointLandmark& moving = landmarks.landmarks().at(0);
+  EXPECT_EQ(moving.sightings[0].velocity, Eigen::Vector2d(0.2, -0.1));
+  EXPECT_EQ(moving.sightings[1].velocity, Eigen::Vector2d(0.2, -0.1));
+  EXPECT_EQ(landmarks.landmarks().at(1).sightings[0].velocity, Eigen::Vector2d::Zero());
+}

@@ -116,24 +116,34 @@ void Estimator::statesToParameters() {
     para_landmarks_.resize(at + OrthonormalLine::kParameterSize);
     OrthonormalLine::fromPlucker(l.line_w).toParameters(&para_landmarks_[at]);
   }
+  para_time_shift_[0] = time_shift_;
+}
+
+bool Estimator::timeShiftEstimated() const {
+  return options_.estimate_time_shift && status_ == EstimatorStatus::kTracking;
 }
 
 double* Estimator::lineBlock(std::size_t k) {
   return &para_landmarks_[num_point_params_ + OrthonormalLine::kParameterSize * k];
 }
 
-PointProjectionFactor* Estimator::newPointFactor(const Eigen::Vector2d& obs_i,
-                                                 const Eigen::Vector2d& obs_j, int i, int j) const {
+PointProjectionFactor* Estimator::newPointFactor(const PointSighting& obs_i,
+                                                 const PointSighting& obs_j, int i, int j) const {
   const double dt = 1e-9 * static_cast<double>(header_ns_[j] - header_ns_[i]);
   const double sigma =
       pointObservationSigmaPx(options_.point_sigma_px, options_.point_drift_px2_per_s, dt);
   const double sqrt_info = point_scale_ * camera_.intrinsics[0] / sigma;
-  return new PointProjectionFactor(obs_i, obs_j, T_b_c_, sqrt_info);
+  auto* factor =
+      new PointProjectionFactor(obs_i.xy1.head<2>(), obs_j.xy1.head<2>(), T_b_c_, sqrt_info);
+  if (timeShiftEstimated()) factor->estimateTimeShift(obs_i.velocity, obs_j.velocity);
+  return factor;
 }
 
 LineProjectionFactor* Estimator::newLineFactor(const LineLandmarkObservation& obs) const {
   const double sqrt_info = line_scale_ * camera_.intrinsics[0] / options_.line_sigma_px;
-  return new LineProjectionFactor(obs.start_norm, obs.end_norm, T_b_c_, sqrt_info);
+  auto* factor = new LineProjectionFactor(obs.start_norm, obs.end_norm, T_b_c_, sqrt_info);
+  if (timeShiftEstimated()) factor->estimateTimeShift(obs.start_velocity, obs.end_velocity);
+  return factor;
 }
 
 std::map<int64_t, int> Estimator::windowSlots() const {
@@ -166,6 +176,7 @@ void Estimator::parametersToStates() {
   }
   points_.setInverseDepths(
       Eigen::Map<const Eigen::VectorXd>(para_landmarks_.data(), num_point_params_));
+  if (timeShiftEstimated()) time_shift_ = para_time_shift_[0];
   // The lines' optimised parameters are not kept: each solve restarts them from the
   // triangulation. Keeping them was measured worse, in ATE and in the map
   // (docs/benchmarks.md, seventh session).
@@ -209,6 +220,17 @@ void Estimator::optimize(FrameTiming* timing, int max_iterations, bool triangula
     ordering->AddElementToGroup(para_pose_[i].data(), 1 + 2 * i);
     ordering->AddElementToGroup(para_speed_bias_[i].data(), 2 + 2 * i);
   }
+  // The visual factors' blocks after the landmark's: the time shift's, when estimated.
+  std::vector<double*> time_shift_block;
+  if (timeShiftEstimated()) {
+    problem.AddParameterBlock(para_time_shift_.data(), 1);
+    ordering->AddElementToGroup(para_time_shift_.data(), 3 + 2 * W_);
+    time_shift_block.push_back(para_time_shift_.data());
+  }
+  const auto with_time_shift = [&time_shift_block](std::vector<double*> blocks) {
+    blocks.insert(blocks.end(), time_shift_block.begin(), time_shift_block.end());
+    return blocks;
+  };
   if (last_marginalization_)
     problem.AddResidualBlock(new MarginalizationFactor(last_marginalization_), nullptr,
                              last_marginalization_blocks_);
@@ -230,13 +252,12 @@ void Estimator::optimize(FrameTiming* timing, int max_iterations, bool triangula
     ++index;
     if (!pointSelected(l)) continue;
     const int i = l.start_frame;
-    const Eigen::Vector2d obs_i = l.sightings.front().xy1.head<2>();
     if (l.sightings.size() > 1) ordering->AddElementToGroup(inverseDepthBlock(index), 0);
     for (std::size_t k = 1; k < l.sightings.size(); ++k) {
       const int j = i + static_cast<int>(k);
-      problem.AddResidualBlock(newPointFactor(obs_i, l.sightings[k].xy1.head<2>(), i, j),
-                               loss.get(), para_pose_[i].data(), para_pose_[j].data(),
-                               inverseDepthBlock(index));
+      problem.AddResidualBlock(
+          newPointFactor(l.sightings.front(), l.sightings[k], i, j), loss.get(),
+          with_time_shift({para_pose_[i].data(), para_pose_[j].data(), inverseDepthBlock(index)}));
     }
   }
   // Lines: one factor per window observation, on the observing frame's pose.
@@ -251,8 +272,8 @@ void Estimator::optimize(FrameTiming* timing, int max_iterations, bool triangula
       problem.AddParameterBlock(line_block, OrthonormalLine::kParameterSize, line_manifold);
       ordering->AddElementToGroup(line_block, 0);
       for (const auto& [ns, obs] : l.observations)
-        problem.AddResidualBlock(newLineFactor(obs), loss.get(), para_pose_[slot.at(ns)].data(),
-                                 line_block);
+        problem.AddResidualBlock(newLineFactor(obs), loss.get(),
+                                 with_time_shift({para_pose_[slot.at(ns)].data(), line_block}));
       if (options_.line_step_damping > 0)
         for (int half : {0, 1})
           problem.AddResidualBlock(
@@ -312,6 +333,12 @@ void Estimator::removeReprojectionOutliers() {
 
 void Estimator::marginalize() {
   statesToParameters();
+  std::vector<double*> time_shift_block;
+  if (timeShiftEstimated()) time_shift_block.push_back(para_time_shift_.data());
+  const auto with_time_shift = [&time_shift_block](std::vector<double*> blocks) {
+    blocks.insert(blocks.end(), time_shift_block.begin(), time_shift_block.end());
+    return blocks;
+  };
   if (marginalization_ == Marginalization::kOld) {
     auto info = std::make_shared<MarginalizationInfo>();
     if (last_marginalization_) {
@@ -342,12 +369,12 @@ void Estimator::marginalize() {
       ++index;
       if (l.start_frame != 0) continue;
       if (!options_.selection.marginalize_unselected && !pointSelected(l)) continue;
-      const Eigen::Vector2d obs_i = l.sightings.front().xy1.head<2>();
       for (std::size_t k = 1; k < l.sightings.size(); ++k)
         info->addResidualBlock(
-            newPointFactor(obs_i, l.sightings[k].xy1.head<2>(), 0, static_cast<int>(k)),
+            newPointFactor(l.sightings.front(), l.sightings[k], 0, static_cast<int>(k)),
             makeLoss(options_),
-            {para_pose_[0].data(), para_pose_[k].data(), inverseDepthBlock(index)}, {0, 2});
+            with_time_shift({para_pose_[0].data(), para_pose_[k].data(), inverseDepthBlock(index)}),
+            {0, 2});
     }
     if (options_.use_lines) {
       // Lines first seen in the oldest frame leave the state with it, like points anchored
@@ -361,7 +388,8 @@ void Estimator::marginalize() {
         if (!options_.selection.marginalize_unselected && !lineSelected(l)) continue;
         for (const auto& [ns, obs] : l.observations)
           info->addResidualBlock(newLineFactor(obs), makeLoss(options_),
-                                 {para_pose_[slot.at(ns)].data(), line_block}, {1});
+                                 with_time_shift({para_pose_[slot.at(ns)].data(), line_block}),
+                                 {1});
       }
     }
     if (!info->marginalize()) {
@@ -374,6 +402,7 @@ void Estimator::marginalize() {
       shift[para_pose_[i].data()] = para_pose_[i - 1].data();
       shift[para_speed_bias_[i].data()] = para_speed_bias_[i - 1].data();
     }
+    shift[para_time_shift_.data()] = para_time_shift_.data();
     last_marginalization_blocks_ = info->keptBlocks(shift);
     last_marginalization_ = info;
     return;
@@ -402,6 +431,7 @@ void Estimator::marginalize() {
     shift[para_speed_bias_[i].data()] = to_sb;
   }
   shift[para_speed_bias_[W_ - 1].data()] = para_speed_bias_[W_ - 1].data();
+  shift[para_time_shift_.data()] = para_time_shift_.data();
   last_marginalization_blocks_ = info->keptBlocks(shift);
   last_marginalization_ = info;
 }

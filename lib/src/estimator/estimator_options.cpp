@@ -33,6 +33,7 @@ EstimatorOptions EstimatorOptions::load(const YamlReader& yaml, const std::strin
   }
   o.use_lines = yaml.getBool(p + "use_lines", o.use_lines);
   o.record_analysis = yaml.getBool(p + "record_analysis", o.record_analysis);
+  o.estimate_time_shift = yaml.getBool(p + "estimate_time_shift", o.estimate_time_shift);
   o.line_sigma_px = yaml.getDouble(p + "line_sigma_px", o.line_sigma_px);
   o.line_min_observations = yaml.getInt(p + "line_min_observations", o.line_min_observations);
   o.line_outlier_px = yaml.getDouble(p + "line_outlier_px", o.line_outlier_px);

@@ -33,6 +33,19 @@ bool fitLimitLooksTooTight(const LineRetirementCounts& counts) {
   return total >= kMinTracksToJudgeTheFitLimit && 4 * counts.held_back_fit > 3 * total;
 }
 
+namespace {
+// An endpoint's motion along its line is the detector's choice of where the segment ends; only
+// the motion across the line, from the previous observation's line, is the line's.
+void setAcrossLineVelocities(const LineLandmarkObservation& previous, double dt_s,
+                             LineLandmarkObservation* obs) {
+  const Eigen::Vector2d direction = previous.end_norm - previous.start_norm;
+  if (!(dt_s > 0) || direction.norm() < 1e-9) return;
+  const Eigen::Vector2d normal = Eigen::Vector2d(-direction.y(), direction.x()).normalized();
+  obs->start_velocity = normal * normal.dot(obs->start_norm - previous.start_norm) / dt_s;
+  obs->end_velocity = normal * normal.dot(obs->end_norm - previous.start_norm) / dt_s;
+}
+}  // namespace
+
 void LineLandmarks::addFrame(
     int64_t frame_ns,
     const std::vector<LineObservation, Eigen::aligned_allocator<LineObservation>>& lines) {
@@ -53,7 +66,19 @@ void LineLandmarks::addFrame(
       it->second.id = o.id;
     else
       ++last_tracked_;
-    it->second.observations[frame_ns] = obs;
+    auto& observations = it->second.observations;
+    if (!observations.empty() && observations.rbegin()->first < frame_ns) {
+      LineLandmarkObservation& previous = observations.rbegin()->second;
+      const double dt_s = 1e-9 * static_cast<double>(frame_ns - observations.rbegin()->first);
+      setAcrossLineVelocities(previous, dt_s, &obs);
+      // The track's first observation takes its second's (see PointLandmarks).
+      if (observations.size() == 1 && previous.start_velocity.isZero() &&
+          previous.end_velocity.isZero()) {
+        previous.start_velocity = obs.start_velocity;
+        previous.end_velocity = obs.end_velocity;
+      }
+    }
+    observations[frame_ns] = obs;
   }
 }
 

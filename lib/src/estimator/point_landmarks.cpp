@@ -30,6 +30,10 @@ bool PointLandmarks::addFrameAndCheckParallax(int frame_index, const FeatureFram
       l.sightings.push_back(s);
       landmarks_.emplace(o.id, std::move(l));
     } else {
+      // A new track has no velocity in its first frame: take its second's (the time shift's
+      // estimate would otherwise read each anchor as still, and pull toward no shift).
+      PointSighting& first = it->second.sightings.front();
+      if (it->second.sightings.size() == 1 && first.velocity.isZero()) first.velocity = s.velocity;
       it->second.sightings.push_back(s);
       ++last_track_num_;
     }

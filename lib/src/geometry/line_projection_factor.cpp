@@ -32,12 +32,22 @@ LineProjectionFactor::LineProjectionFactor(const Eigen::Vector2d& start_norm,
       end_(end_norm),
       R_c_b_(T_b_c.linear().transpose()),
       t_b_c_(T_b_c.translation()),
-      sqrt_info_(sqrt_info) {}
+      sqrt_info_(sqrt_info) {
+  set_num_residuals(2);
+  *mutable_parameter_block_sizes() = {7, 4};
+}
 
-bool LineProjectionFactor::residual(const double* pose, const double* line,
-                                    Eigen::Vector2d* r) const {
+void LineProjectionFactor::estimateTimeShift(const Eigen::Vector2d& start_velocity,
+                                             const Eigen::Vector2d& end_velocity) {
+  start_velocity_ = start_velocity;
+  end_velocity_ = end_velocity;
+  if (parameter_block_sizes().size() == 2) mutable_parameter_block_sizes()->push_back(1);
+}
+
+bool LineProjectionFactor::residual(const double* pose, const double* line, Eigen::Vector2d* r,
+                                    double time_shift) const {
   double residuals[2];
-  const double* params[2] = {pose, line};
+  const double* params[3] = {pose, line, &time_shift};
   if (!Evaluate(params, residuals, nullptr)) return false;
   *r = Eigen::Vector2d(residuals[0], residuals[1]);
   return true;
@@ -65,8 +75,13 @@ bool LineProjectionFactor::Evaluate(double const* const* parameters, double* res
   const double norm2 = l.x() * l.x() + l.y() * l.y();
   const double norm = std::sqrt(norm2);
   if (!(norm > kMinImageLineNorm)) return false;
-  const Eigen::Vector3d s(start_.x(), start_.y(), 1.0);
-  const Eigen::Vector3d e(end_.x(), end_.y(), 1.0);
+  const bool with_time_shift = parameter_block_sizes().size() == 3;
+  const double td = with_time_shift ? parameters[2][0] : 0.0;
+  const Eigen::Vector2d start =
+      with_time_shift ? Eigen::Vector2d(start_ - td * start_velocity_) : start_;
+  const Eigen::Vector2d end = with_time_shift ? Eigen::Vector2d(end_ - td * end_velocity_) : end_;
+  const Eigen::Vector3d s(start.x(), start.y(), 1.0);
+  const Eigen::Vector3d e(end.x(), end.y(), 1.0);
   const double s_l = s.dot(l), e_l = e.dot(l);
   residuals[0] = sqrt_info_ * s_l / norm;
   residuals[1] = sqrt_info_ * e_l / norm;
@@ -99,6 +114,12 @@ bool LineProjectionFactor::Evaluate(double const* const* parameters, double* res
     J.leftCols<3>() = J_tangent.leftCols<3>() *
                       rightJacobianSO3(Eigen::Vector3d(x_line[0], x_line[1], x_line[2]));
     J.col(3) = J_tangent.col(3);
+  }
+  if (with_time_shift && jacobians[2]) {
+    // d(p.l)/dp = (l1, l2) for each endpoint p, moved by -td * velocity.
+    const Eigen::Vector2d l12_over_norm = sqrt_info_ * Eigen::Vector2d(l.x(), l.y()) / norm;
+    jacobians[2][0] = -l12_over_norm.dot(start_velocity_);
+    jacobians[2][1] = -l12_over_norm.dot(end_velocity_);
   }
   return true;
 }

@@ -98,7 +98,7 @@ RunResult runOffline(SensorSource& source, const Config& config, const RunOption
          "jacobian_ms\n";
   // The newest state as estimated when its frame arrived: whether the IMU biases settle.
   std::ostringstream states;
-  states << "t,vx,vy,vz,bax,bay,baz,bgx,bgy,bgz\n";
+  states << "t,vx,vy,vz,bax,bay,baz,bgx,bgy,bgz,time_shift_s\n";
   if (!(options.start_s >= 0))
     throw Error("start must be >= 0 s, got " + std::to_string(options.start_s));
   // The images left after the start, as the camera's rate counts them (for the progress bar).
@@ -174,9 +174,9 @@ RunResult runOffline(SensorSource& source, const Config& config, const RunOption
                     o.unsuccessful_steps, o.solver_ms, o.linear_solver_ms, o.jacobian_ms);
       frame_stats << row;
       const BodyState& x = out.state;
-      std::snprintf(row, sizeof(row), "%.6f,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f,%.6f,%.6f,%.6f\n", x.t,
-                    x.v.x(), x.v.y(), x.v.z(), x.ba.x(), x.ba.y(), x.ba.z(), x.bg.x(), x.bg.y(),
-                    x.bg.z());
+      std::snprintf(row, sizeof(row), "%.6f,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f,%.6f,%.6f,%.6f,%.6f\n",
+                    x.t, x.v.x(), x.v.y(), x.v.z(), x.ba.x(), x.ba.y(), x.ba.z(), x.bg.x(),
+                    x.bg.y(), x.bg.z(), pipeline.estimator().timeShift());
       states << row;
       StampedPose p;
       p.t = out.state.t;
@@ -251,6 +251,8 @@ RunResult runOffline(SensorSource& source, const Config& config, const RunOption
   result.dropped_imu = pipeline.estimator().droppedImu();
   result.line_retirement = pipeline.estimator().lineRetirementCounts();
   result.poses = result.trajectory.size();
+  if (config.estimator.estimate_time_shift)
+    result.estimated_time_shift_s = pipeline.estimator().timeShift();
 
   writeTumTrajectory((fs::path(options.out_dir) / "trajectory.tum").string(), result.trajectory);
   writeFileAtomically((fs::path(options.out_dir) / "timing.csv").string(), result.timing.toCsv());
@@ -273,6 +275,11 @@ RunResult runOffline(SensorSource& source, const Config& config, const RunOption
   summary["lines_held_back_edge"] = result.line_retirement.held_back_edge;
   summary["lines_held_back_uncertain"] = result.line_retirement.held_back_uncertain;
   summary["interrupted"] = result.interrupted;
+  if (result.estimated_time_shift_s) {
+    summary["estimated_time_shift_s"] = *result.estimated_time_shift_s;
+    summary["timeshift_cam_imu_s"] =
+        config.camera.timeshift_cam_imu + *result.estimated_time_shift_s;
+  }
   for (const auto& s : result.timing.summary())
     summary["timing_ms"][s.stage] = {
         {"median", s.median_ms}, {"p95", s.p95_ms}, {"max", s.max_ms}, {"mean", s.mean_ms}};

@@ -149,6 +149,10 @@ class Estimator {
   const OptimizationStats& lastOptimizationStats() const { return stats_; }
   const PointLandmarks& points() const { return points_; }
   const LineLandmarks& lines() const { return lines_; }
+  /// The estimated time shift [s] on top of camera.timeshift_cam_imu (0 unless
+  /// options.estimate_time_shift): an image stamped t was taken at t + timeShift(). Kept
+  /// through resets, as a property of the sensors.
+  double timeShift() const { return time_shift_; }
 
  private:
   struct ImageFrame {
@@ -239,10 +243,16 @@ class Estimator {
   double* lineBlock(std::size_t k);
   // Reprojection factors at the current weights, for the window solve and the prior alike:
   // sighting obs_j in window frame j against the anchor obs_i in frame i.
-  PointProjectionFactor* newPointFactor(const Eigen::Vector2d& obs_i, const Eigen::Vector2d& obs_j,
+  PointProjectionFactor* newPointFactor(const PointSighting& obs_i, const PointSighting& obs_j,
                                         int i, int j) const;
   LineProjectionFactor* newLineFactor(const LineLandmarkObservation& obs) const;
   std::map<int64_t, int> windowSlots() const;  ///< frame stamp -> index in the window
+
+  /// The time shift is a window parameter when estimated (options_.estimate_time_shift) and
+  /// the estimator tracks; its factors then take para_time_shift_ as their last block.
+  bool timeShiftEstimated() const;
+  double time_shift_ = 0;
+  std::array<double, 1> para_time_shift_{};
 
   std::shared_ptr<MarginalizationInfo> last_marginalization_;
   std::vector<double*> last_marginalization_blocks_;

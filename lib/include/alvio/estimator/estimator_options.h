@@ -32,6 +32,9 @@ struct EstimatorOptions {
   } imu_noise;
 
   bool record_analysis = false;  ///< keep WindowTrackRecords (alvio run --analysis)
+  /// Estimate the camera's time shift on top of camera.timeshift_cam_imu (VINS-Mono's td):
+  /// a parameter of the window moving every observation along its image velocity.
+  bool estimate_time_shift = false;
 
   // Lines.
   bool use_lines = true;          ///< line landmarks in the optimisation

@@ -27,6 +27,10 @@ struct LineLandmarkObservation {
   bool on_edge = false;       ///< the map's positions below are set (LineObservation::on_edge)
   Eigen::Vector2d edge_start_norm = Eigen::Vector2d::Zero();
   Eigen::Vector2d edge_end_norm = Eigen::Vector2d::Zero();
+  /// The endpoints' image velocities across the line (normalised units per second), from the
+  /// line's previous observation; zero for its first. Only the time shift's estimate uses them.
+  Eigen::Vector2d start_velocity = Eigen::Vector2d::Zero();
+  Eigen::Vector2d end_velocity = Eigen::Vector2d::Zero();
   EIGEN_MAKE_ALIGNED_OPERATOR_NEW
 };
 

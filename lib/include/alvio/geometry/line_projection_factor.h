@@ -16,28 +16,35 @@
 // sqrt_info = f / sigma_px (f the focal length in pixels, sigma_px the endpoint noise in
 // pixels) the residual is in units of sigma (pixels / sigma_px). The robust loss is the
 // caller's choice, given to Problem::AddResidualBlock.
+//
+// With estimateTimeShift() a third block, the camera's time shift td (1 double; see
+// PointProjectionFactor): each endpoint is moved back by td times its image velocity.
 
-#include <ceres/sized_cost_function.h>
+#include <ceres/cost_function.h>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
 namespace alvio {
 
-class LineProjectionFactor final : public ceres::SizedCostFunction<2, 7, 4> {
+class LineProjectionFactor final : public ceres::CostFunction {
  public:
   /// @param start_norm, end_norm observed endpoints, undistorted normalised coordinates.
   /// @param T_b_c camera pose in the body frame (constant extrinsic).
   /// @param sqrt_info scale of the residual (see the file comment).
   LineProjectionFactor(const Eigen::Vector2d& start_norm, const Eigen::Vector2d& end_norm,
                        const Eigen::Isometry3d& T_b_c, double sqrt_info = 1.0);
+  /// Adds the time shift block: the endpoints' velocities, normalised units per second.
+  void estimateTimeShift(const Eigen::Vector2d& start_velocity,
+                         const Eigen::Vector2d& end_velocity);
 
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
 
-  /// The residual at a pose block and a line block (no Jacobians); false if the line
-  /// projects to a point (it passes through the camera centre).
-  bool residual(const double* pose, const double* line, Eigen::Vector2d* r) const;
+  /// The residual at a pose block and a line block (and the time shift, when estimated; no
+  /// Jacobians); false if the line projects to a point (it passes through the camera centre).
+  bool residual(const double* pose, const double* line, Eigen::Vector2d* r,
+                double time_shift = 0.0) const;
 
   const Eigen::Vector2d& startNorm() const { return start_; }
   const Eigen::Vector2d& endNorm() const { return end_; }
@@ -45,6 +52,8 @@ class LineProjectionFactor final : public ceres::SizedCostFunction<2, 7, 4> {
 
  private:
   Eigen::Vector2d start_, end_;
+  Eigen::Vector2d start_velocity_ = Eigen::Vector2d::Zero(),
+                  end_velocity_ = Eigen::Vector2d::Zero();
   Eigen::Matrix3d R_c_b_;
   Eigen::Vector3d t_b_c_;
   double sqrt_info_;

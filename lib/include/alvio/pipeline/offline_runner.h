@@ -59,6 +59,8 @@ struct RunResult {
   std::optional<EvaluationResult> evaluation;  ///< SE(3) ATE, when ground truth exists
   double observer_ms = 0;                ///< wall time spent in observers' onStart/onImu/onFrame
   LineRetirementCounts line_retirement;  ///< lines handed to the maps or held back
+  /// estimator.estimate_time_shift: the estimate at the end, on top of camera.timeshift_cam_imu.
+  std::optional<double> estimated_time_shift_s;
 };
 
 RunResult runOffline(SensorSource& source, const Config& config, const RunOptions& options);

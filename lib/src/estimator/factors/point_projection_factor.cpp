@@ -12,7 +12,17 @@ PointProjectionFactor::PointProjectionFactor(const Eigen::Vector2d& obs_i,
       pts_j_(obs_j.x(), obs_j.y(), 1.0),
       R_b_c_(T_b_c.linear()),
       t_b_c_(T_b_c.translation()),
-      sqrt_info_(sqrt_info) {}
+      sqrt_info_(sqrt_info) {
+  set_num_residuals(2);
+  *mutable_parameter_block_sizes() = {7, 7, 1};
+}
+
+void PointProjectionFactor::estimateTimeShift(const Eigen::Vector2d& velocity_i,
+                                              const Eigen::Vector2d& velocity_j) {
+  velocity_i_ << velocity_i, 0.0;
+  velocity_j_ << velocity_j, 0.0;
+  if (parameter_block_sizes().size() == 3) mutable_parameter_block_sizes()->push_back(1);
+}
 
 bool PointProjectionFactor::Evaluate(double const* const* parameters, double* residuals,
                                      double** jacobians) const {
@@ -21,9 +31,15 @@ bool PointProjectionFactor::Evaluate(double const* const* parameters, double* re
   const Eigen::Vector3d Pj = posePosition(parameters[1]);
   const Eigen::Quaterniond Qj = poseRotation(parameters[1]).normalized();
   const double inv_depth = parameters[2][0];
+  const bool with_time_shift = parameter_block_sizes().size() == 4;
+  const double td = with_time_shift ? parameters[3][0] : 0.0;
+  const Eigen::Vector3d pts_i =
+      with_time_shift ? Eigen::Vector3d(pts_i_ - td * velocity_i_) : pts_i_;
+  const Eigen::Vector3d pts_j =
+      with_time_shift ? Eigen::Vector3d(pts_j_ - td * velocity_j_) : pts_j_;
 
   // Camera i -> body i -> world -> body j -> camera j.
-  const Eigen::Vector3d p_ci = pts_i_ / inv_depth;
+  const Eigen::Vector3d p_ci = pts_i / inv_depth;
   const Eigen::Vector3d p_bi = R_b_c_ * p_ci + t_b_c_;
   const Eigen::Vector3d p_w = Qi * p_bi + Pi;
   const Eigen::Vector3d p_bj = Qj.inverse() * (p_w - Pj);
@@ -31,7 +47,7 @@ bool PointProjectionFactor::Evaluate(double const* const* parameters, double* re
   const double z = p_cj.z();
 
   Eigen::Map<Eigen::Vector2d> r(residuals);
-  r = sqrt_info_ * (p_cj.head<2>() / z - pts_j_.head<2>());
+  r = sqrt_info_ * (p_cj.head<2>() / z - pts_j.head<2>());
   if (!jacobians) return true;
 
   const Eigen::Matrix3d Ri = Qi.toRotationMatrix(), Rj = Qj.toRotationMatrix();
@@ -57,7 +73,11 @@ bool PointProjectionFactor::Evaluate(double const* const* parameters, double* re
   }
   if (jacobians[2]) {
     Eigen::Map<Eigen::Vector2d> J(jacobians[2]);
-    J = d_p_bi * R_b_c_ * pts_i_ * (-1.0 / (inv_depth * inv_depth));
+    J = d_p_bi * R_b_c_ * pts_i * (-1.0 / (inv_depth * inv_depth));
+  }
+  if (with_time_shift && jacobians[3]) {
+    Eigen::Map<Eigen::Vector2d> J(jacobians[3]);
+    J = d_p_bi * R_b_c_ * velocity_i_ * (-1.0 / inv_depth) + sqrt_info_ * velocity_j_.head<2>();
   }
   return true;
 }
