@@ -311,6 +311,64 @@ TEST(Marginalization, PriorOfOneFactorEqualsSchurComplement) {
   }
 }
 
+// A random walk on a kept coordinate (the camera's time shift) adds its variance to the prior's
+// covariance and keeps the prior's mean.
+TEST(Marginalization, RandomWalkWidensAKeptCoordinateAndKeepsTheMean) {
+  std::mt19937 gen(5);
+  std::normal_distribution<double> normal;
+  Eigen::Matrix<double, 10, 8> A;
+  Eigen::Matrix<double, 10, 1> b;
+  for (int i = 0; i < A.size(); ++i) A.data()[i] = 10 * normal(gen);
+  for (int i = 0; i < b.size(); ++i) b[i] = normal(gen);
+  double x1[3] = {0.1, -0.2, 0.3}, x2[5] = {0.05, 0.4, -0.1, 0.2, 0.0};
+  // The first kept coordinate as a block of its own: x2 = [shift, rest].
+  class Split : public ceres::CostFunction {
+   public:
+    explicit Split(const LinearFactor* f) : f_(f) {
+      set_num_residuals(10);
+      *mutable_parameter_block_sizes() = {3, 1, 4};
+    }
+    bool Evaluate(double const* const* x, double* r, double** J) const override {
+      double x2[5] = {x[1][0], x[2][0], x[2][1], x[2][2], x[2][3]};
+      const double* xx[2] = {x[0], x2};
+      Eigen::Matrix<double, 10, 5, Eigen::RowMajor> J2;
+      double* jj[2] = {J ? J[0] : nullptr, J2.data()};
+      if (!f_->Evaluate(xx, r, J ? jj : nullptr)) return false;
+      if (J && J[1]) Eigen::Map<Eigen::Matrix<double, 10, 1>>{J[1]} = J2.col(0);
+      if (J && J[2])
+        Eigen::Map<Eigen::Matrix<double, 10, 4, Eigen::RowMajor>>{J[2]} = J2.rightCols<4>();
+      return true;
+    }
+
+   private:
+    std::unique_ptr<const LinearFactor> f_;
+  };
+  const double q = 0.3;
+  auto info = std::make_shared<MarginalizationInfo>();
+  info->addResidualBlock(new Split(new LinearFactor(A, b)), nullptr, {x1, x2, x2 + 1}, {0});
+  info->addRandomWalk(x2, q);
+  ASSERT_TRUE(info->marginalize());
+  Eigen::Matrix<double, 8, 1> x;
+  x << Eigen::Map<Eigen::Vector3d>(x1), Eigen::Map<Eigen::Matrix<double, 5, 1>>(x2);
+  const Eigen::MatrixXd H = A.transpose() * A;
+  const Eigen::VectorXd g = A.transpose() * (A * x + b);
+  const Eigen::MatrixXd H11_inv = H.topLeftCorner(3, 3).inverse();
+  const Eigen::MatrixXd H22 =
+      H.bottomRightCorner(5, 5) - H.bottomLeftCorner(5, 3) * H11_inv * H.topRightCorner(3, 5);
+  const Eigen::VectorXd g2 = g.tail(5) - H.bottomLeftCorner(5, 3) * H11_inv * g.head(3);
+  Eigen::MatrixXd P = H22.inverse();
+  const Eigen::VectorXd mean = -P * g2;
+  P(0, 0) += q;
+  const Eigen::MatrixXd H_walked = P.inverse();
+  const Eigen::MatrixXd& J = info->linearizedJacobian();
+  const Eigen::VectorXd g_prior = J.transpose() * info->linearizedResidual();
+  EXPECT_LT((J.transpose() * J - H_walked).norm() / H_walked.norm(), 1e-9);
+  EXPECT_LT((-(J.transpose() * J).inverse() * g_prior - mean).norm() / mean.norm(), 1e-9);
+  // The other coordinates keep much of what they knew: the walk is not a reset.
+  EXPECT_GT(H_walked(1, 1), 0.1 * H22(1, 1));
+  EXPECT_LT(H_walked(0, 0), 1.0 / q);
+}
+
 // A rank-deficient information, at the scale of a window's prior, becomes as many rows as it
 // has rank, each non-zero, and reproduces the information and gradient.
 TEST(Marginalization, FactorPriorKeepsRankAndInformation) {

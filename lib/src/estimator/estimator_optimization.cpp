@@ -119,6 +119,17 @@ void Estimator::statesToParameters() {
   para_time_shift_[0] = time_shift_;
 }
 
+double Estimator::windowTurnRate() const {
+  double sum = 0;
+  std::size_t n = 0;
+  for (int i = 1; i <= frame_count_; ++i)
+    for (const Eigen::Vector3d& w : gyr_buf_[i]) {
+      sum += (w - Bgs_[i]).squaredNorm();
+      ++n;
+    }
+  return n > 0 ? std::sqrt(sum / static_cast<double>(n)) : 0.0;
+}
+
 bool Estimator::timeShiftEstimated() const {
   return options_.estimate_time_shift && status_ == EstimatorStatus::kTracking;
 }
@@ -226,6 +237,8 @@ void Estimator::optimize(FrameTiming* timing, int max_iterations, bool triangula
     problem.AddParameterBlock(para_time_shift_.data(), 1);
     ordering->AddElementToGroup(para_time_shift_.data(), 3 + 2 * W_);
     time_shift_block.push_back(para_time_shift_.data());
+    if (windowTurnRate() < options_.time_shift_min_turn_rate)
+      problem.SetParameterBlockConstant(para_time_shift_.data());
   }
   const auto with_time_shift = [&time_shift_block](std::vector<double*> blocks) {
     blocks.insert(blocks.end(), time_shift_block.begin(), time_shift_block.end());
@@ -392,6 +405,11 @@ void Estimator::marginalize() {
                                  {1});
       }
     }
+    // The shift drifts: what the prior knows of it fades over the oldest keyframe's span.
+    if (timeShiftEstimated())
+      info->addRandomWalk(para_time_shift_.data(), options_.time_shift_random_walk *
+                                                       options_.time_shift_random_walk *
+                                                       (headers_[1] - headers_[0]));
     if (!info->marginalize()) {
       last_marginalization_.reset();
       last_marginalization_blocks_.clear();

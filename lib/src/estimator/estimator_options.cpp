@@ -34,6 +34,9 @@ EstimatorOptions EstimatorOptions::load(const YamlReader& yaml, const std::strin
   o.use_lines = yaml.getBool(p + "use_lines", o.use_lines);
   o.record_analysis = yaml.getBool(p + "record_analysis", o.record_analysis);
   o.estimate_time_shift = yaml.getBool(p + "estimate_time_shift", o.estimate_time_shift);
+  o.time_shift_random_walk = yaml.getDouble(p + "time_shift_random_walk", o.time_shift_random_walk);
+  o.time_shift_min_turn_rate =
+      yaml.getDouble(p + "time_shift_min_turn_rate", o.time_shift_min_turn_rate);
   o.line_sigma_px = yaml.getDouble(p + "line_sigma_px", o.line_sigma_px);
   o.line_min_observations = yaml.getInt(p + "line_min_observations", o.line_min_observations);
   o.line_outlier_px = yaml.getDouble(p + "line_outlier_px", o.line_outlier_px);
@@ -105,6 +108,8 @@ EstimatorOptions EstimatorOptions::load(const YamlReader& yaml, const std::strin
     throw Error(yaml.where(p + "line_step_damping") + " must not be negative (0: off)");
   if (o.line_map_min_parallax < 0)
     throw Error(yaml.where(p + "line_map_min_parallax") + " must not be negative (0: no limit)");
+  if (o.time_shift_random_walk < 0)
+    throw Error(yaml.where(p + "time_shift_random_walk") + " must not be negative (0: constant)");
   if (o.imu_noise_scale <= 0) throw Error(yaml.where(p + "imu_noise_scale") + " must be positive");
   return o;
 }

@@ -251,6 +251,7 @@ class Estimator {
   /// The time shift is a window parameter when estimated (options_.estimate_time_shift) and
   /// the estimator tracks; its factors then take para_time_shift_ as their last block.
   bool timeShiftEstimated() const;
+  double windowTurnRate() const;  ///< RMS of the bias-free gyroscope over the window [rad/s]
   double time_shift_ = 0;
   std::array<double, 1> para_time_shift_{};
 

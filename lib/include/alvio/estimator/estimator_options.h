@@ -35,6 +35,12 @@ struct EstimatorOptions {
   /// Estimate the camera's time shift on top of camera.timeshift_cam_imu (VINS-Mono's td):
   /// a parameter of the window moving every observation along its image velocity.
   bool estimate_time_shift = false;
+  /// How fast the shift may drift [s per sqrt(s)]: its random walk, by which the window's
+  /// prior forgets old evidence of it. 0: a constant shift.
+  double time_shift_random_walk = 0.0;
+  /// The shift is held while the window turns slower than this (RMS, rad/s): on a steady
+  /// translation it is nearly unobservable (a shift moves every pose along the path alike).
+  double time_shift_min_turn_rate = 0.3;
 
   // Lines.
   bool use_lines = true;          ///< line landmarks in the optimisation

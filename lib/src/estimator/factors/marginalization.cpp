@@ -268,10 +268,14 @@ MarginalizationInfo::Layout MarginalizationInfo::planLayout() const {
   return layout;
 }
 
+void MarginalizationInfo::addRandomWalk(double* block, double variance) {
+  if (variance > 0) random_walks_.emplace_back(block, variance);
+}
+
 bool MarginalizationInfo::marginalize() {
   const Layout layout = planLayout();
   if (layout.n == 0) return false;
-  if (layout.landmarks.empty() && layout.state_factors.size() == 1) {
+  if (layout.landmarks.empty() && layout.state_factors.size() == 1 && random_walks_.empty()) {
     // The prior alone, when the second-newest frame leaves the window (every frame that is
     // not a keyframe): no information matrix needed.
     const Block& f = factors_[layout.state_factors[0]];
@@ -377,6 +381,18 @@ void MarginalizationInfo::formPriorFromInformation(const Layout& layout) {
     const Eigen::MatrixXd Hrm = H.bottomLeftCorner(n, m);
     Hrr -= Hrm * Hmm_inv * Hrm.transpose();
     gr -= Hrm * Hmm_inv * g.head(m);
+  }
+  // A random walk of variance q on kept coordinate k keeps the prior's mean and makes its
+  // covariance P + q e_k e_k^T; by Woodbury the information becomes H - s H e_k e_k^T H with
+  // s = 1 / (1/q + H_kk), which needs no inverse of a possibly singular H.
+  for (const auto& [block, variance] : random_walks_) {
+    const auto at = layout.offset.find(block);
+    if (at == layout.offset.end() || at->second < m || layout.size_of.at(block) != 1) continue;
+    const int k = at->second - m;
+    const double s = 1.0 / (1.0 / variance + Hrr(k, k));
+    const Eigen::VectorXd h = Hrr.col(k);
+    gr -= s * gr(k) * h;
+    Hrr -= s * h * h.transpose();
   }
   factorPrior(0.5 * (Hrr + Hrr.transpose()), gr, &linearized_jacobian_, &linearized_residual_);
 }

@@ -23,6 +23,10 @@ class MarginalizationInfo {
   void addResidualBlock(ceres::CostFunction* cost, ceres::LossFunction* loss,
                         std::vector<double*> blocks, std::vector<int> drop);
 
+  /// A kept Euclidean block of size 1 that drifts: `variance` is added to its variance in the
+  /// prior (a random walk since the last prior), so old information about it fades.
+  void addRandomWalk(double* block, double variance);
+
   /// Evaluate all factors at the current parameter values and form the prior.
   /// Returns false when nothing is kept or the kept states learn nothing (no prior).
   bool marginalize();
@@ -61,6 +65,7 @@ class MarginalizationInfo {
   void formPriorFromInformation(const Layout& layout);
 
   std::vector<Block> factors_;
+  std::vector<std::pair<double*, double>> random_walks_;
   std::vector<double*> kept_addresses_;
   std::vector<int> kept_sizes_;
   std::vector<std::vector<double>> kept_values_;
